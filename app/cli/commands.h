@@ -1,0 +1,13 @@
+// The subcommands of the avatarbooth executable; each registers its options and its run function.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace avatarbooth {
+
+// `avatarbooth fit`: a front + side photo pair to a textured head in an output folder.
+void registerFitCommand(CLI::App& app);
+// `avatarbooth make-base-head`: writes the built-in base head and its feature file, to study or edit.
+void registerMakeBaseHeadCommand(CLI::App& app);
+
+}  // namespace avatarbooth

@@ -1,0 +1,32 @@
+// The avatarbooth executable: one binary, one subcommand per job (fit now; run, batch, check later).
+#include "cli/commands.h"
+#include "cli/exit_codes.h"
+
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+
+int main(int argc, char** argv) {
+    CLI::App app{"avatarbooth: a photo booth that turns a front and a side photo into a 3-D head"};
+    app.set_version_flag("--version", std::string("avatarbooth ") + AVATARBOOTH_VERSION);
+    app.require_subcommand(1);
+    bool verbose = false;
+    app.add_flag("-v,--verbose", verbose, "Log each stage as it runs");
+    app.footer("Exit codes: 0 ok, 1 internal error, 2 usage, 3 bad input file, 4 no face found,\n"
+               "            5 photos do not match, 6 bad config, 7 output not writable.");
+    avatarbooth::registerFitCommand(app);
+    avatarbooth::registerMakeBaseHeadCommand(app);
+    app.parse_complete_callback([&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::warn); });
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    } catch (const avatarbooth::BoothError& e) {
+        std::cerr << "avatarbooth: error: " << e.what() << "\n";
+        return avatarbooth::exitCodeFor(e.kind());
+    } catch (const std::exception& e) {
+        std::cerr << "avatarbooth: internal error: " << e.what() << "\n";
+        return avatarbooth::kExitInternal;
+    }
+    return avatarbooth::kExitOk;
+}
