@@ -9,5 +9,7 @@ namespace avatarbooth {
 void registerFitCommand(CLI::App& app);
 // `avatarbooth make-base-head`: writes the built-in base head and its feature file, to study or edit.
 void registerMakeBaseHeadCommand(CLI::App& app);
+// `avatarbooth make-visitor`: writes a synthetic visitor's session folder (photos with known ground truth).
+void registerMakeVisitorCommand(CLI::App& app);
 
 }  // namespace avatarbooth

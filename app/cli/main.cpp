@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
                "            5 photos do not match, 6 bad config, 7 output not writable.");
     avatarbooth::registerFitCommand(app);
     avatarbooth::registerMakeBaseHeadCommand(app);
+    avatarbooth::registerMakeVisitorCommand(app);
     app.parse_complete_callback([&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::warn); });
     try {
         app.parse(argc, argv);

@@ -1,8 +1,52 @@
-// `avatarbooth make-base-head -o DIR`
+// `avatarbooth make-base-head -o DIR` and `avatarbooth make-visitor -o DIR`: the built-in base head and the
+// synthetic visitor, written out to study, edit, or feed to `fit`.
 #include "cli/commands.h"
 
+#include "common/atomic_output.h"
+#include "export/glb.h"
+#include "head/base_head.h"
+#include "sim/synthetic_visitor.h"
+
+#include <iostream>
+
 namespace avatarbooth {
+
 void registerMakeBaseHeadCommand(CLI::App& app) {
-    app.add_subcommand("make-base-head", "Write the built-in base head (glb) and its feature file");
+    auto* cmd = app.add_subcommand("make-base-head", "Write the built-in base head (glb) and its feature file");
+    auto out = std::make_shared<std::string>();
+    cmd->add_option("-o,--output", *out, "Output folder")->required();
+    cmd->callback([out] {
+        const BaseHead& head = builtinBaseHead();
+        StagedDirectory dir(*out, "base_head.features.json");
+        writeGlb(dir.staging() / "base_head.glb", head.mesh, paintSyntheticFace(head, 1024), "base-head");
+        saveFeatureFile(head, dir.staging() / "base_head.features.json");
+        dir.commit();
+        std::cout << "base head: " << head.mesh.vertexCount() << " vertices, " << head.mesh.triangles.size()
+                  << " triangles\nwritten to " << *out << "/base_head.glb and base_head.features.json\n";
+    });
 }
+
+void registerMakeVisitorCommand(CLI::App& app) {
+    auto* cmd = app.add_subcommand("make-visitor",
+                                   "Write a synthetic visitor's session folder (front, side, background, truth/)");
+    struct Options {
+        std::string out;
+        SyntheticVisitorOptions visitor;
+        bool noseLeft = false;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("-o,--output", o->out, "Output folder")->required();
+    cmd->add_option("--seed", o->visitor.seed, "Which visitor (0 = the base head itself)")->capture_default_str();
+    cmd->add_flag("--nose-left", o->noseLeft, "Side photo with the nose pointing image-left");
+    cmd->callback([o] {
+        o->visitor.sideNoseImageRight = !o->noseLeft;
+        MeshRenderer renderer;
+        const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, o->visitor);
+        StagedDirectory dir(o->out, "truth");
+        writeSyntheticVisitorFolder(visitor, dir.staging());
+        dir.commit();
+        std::cout << "synthetic visitor " << o->visitor.seed << " written to " << o->out << "\n";
+    });
+}
+
 }  // namespace avatarbooth

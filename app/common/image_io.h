@@ -1,0 +1,20 @@
+// Reading photos with checks that turn every kind of bad file into a clear error naming the file.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <filesystem>
+
+namespace avatarbooth {
+
+struct PhotoLimits {
+    // Larger photos are refused before decoding (a 24-megapixel still is the largest a booth camera makes).
+    long long maxPixels = 40'000'000;
+    int minSide = 64;
+};
+
+// Reads a JPEG or PNG (or BMP/PPM) photo as 8-bit BGR. Throws BoothError(BadInput) naming the file and the
+// reason: missing, not a regular file, empty, unknown format, truncated, too large, undecodable.
+cv::Mat readPhoto(const std::filesystem::path& path, const PhotoLimits& limits = {});
+
+}  // namespace avatarbooth

@@ -1,0 +1,91 @@
+// dlib's HOG frontal face detector and 68-point shape predictor (the only landmark model Debian ships:
+// libdlib-data, trained on iBUG 300-W, whose terms exclude commercial use — the path is configurable).
+#include "face/landmarks68.h"
+
+#include "common/error.h"
+
+#include <dlib/image_processing.h>
+#include <dlib/image_processing/frontal_face_detector.h>
+#include <dlib/opencv/cv_image.h>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cstdio>
+
+namespace avatarbooth {
+
+std::string landmarkName(int k) {
+    char name[16];
+    std::snprintf(name, sizeof name, "ibug_%02d", k);
+    return name;
+}
+
+struct LandmarkDetector::Impl {
+    dlib::frontal_face_detector detector = dlib::get_frontal_face_detector();
+    dlib::shape_predictor predictor;
+};
+
+LandmarkDetector::LandmarkDetector(const std::filesystem::path& model) : impl_(std::make_unique<Impl>()) {
+    if (!std::filesystem::is_regular_file(model))
+        throw BoothError(ErrorKind::BadConfig, model.string(),
+                         "landmark model not found (install Debian's libdlib-data, or set [face] landmark_model)");
+    try {
+        dlib::deserialize(model.string()) >> impl_->predictor;
+    } catch (const std::exception& e) {
+        throw BoothError(ErrorKind::BadConfig, model.string(), std::string("is not a dlib shape predictor: ") + e.what());
+    }
+    if (impl_->predictor.num_parts() != 68)
+        throw BoothError(ErrorKind::BadConfig, model.string(),
+                         "has " + std::to_string(impl_->predictor.num_parts()) + " landmarks, 68 expected");
+}
+
+LandmarkDetector::~LandmarkDetector() = default;
+
+std::vector<cv::Rect> LandmarkDetector::detectFaces(const cv::Mat& bgr) const {
+    // HOG detection costs grow with the pixel count; 800 px keeps a booth face (>= 150 px) well above dlib's
+    // 80 px minimum, and small photos are upsampled once so that small faces are still found.
+    constexpr int kMaxSide = 800;
+    const double scale = std::min(1.0, static_cast<double>(kMaxSide) / std::max(bgr.cols, bgr.rows));
+    cv::Mat grey;
+    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+    if (scale < 1.0) cv::resize(grey, grey, cv::Size(), scale, scale, cv::INTER_AREA);
+    double detectScale = scale;
+    if (std::max(grey.cols, grey.rows) < 500) {
+        cv::resize(grey, grey, cv::Size(), 2.0, 2.0, cv::INTER_LINEAR);
+        detectScale *= 2.0;
+    }
+    const std::vector<dlib::rectangle> found = impl_->detector(dlib::cv_image<unsigned char>(grey));
+    std::vector<cv::Rect> boxes;
+    for (const auto& r : found) {
+        boxes.emplace_back(cv::Point(static_cast<int>(std::lround(static_cast<double>(r.left()) / detectScale)),
+                                     static_cast<int>(std::lround(static_cast<double>(r.top()) / detectScale))),
+                           cv::Point(static_cast<int>(std::lround(static_cast<double>(r.right() + 1) / detectScale)),
+                                     static_cast<int>(std::lround(static_cast<double>(r.bottom() + 1) / detectScale))));
+    }
+    std::sort(boxes.begin(), boxes.end(), [](const cv::Rect& a, const cv::Rect& b) { return a.area() > b.area(); });
+    return boxes;
+}
+
+std::array<cv::Point2d, 68> LandmarkDetector::landmarksIn(const cv::Mat& bgr, const cv::Rect& face) const {
+    cv::Mat grey;
+    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+    dlib::cv_image<unsigned char> image(grey);
+    const dlib::full_object_detection shape =
+        impl_->predictor(image, dlib::rectangle(face.x, face.y, face.x + face.width - 1, face.y + face.height - 1));
+    std::array<cv::Point2d, 68> points{};
+    for (unsigned k = 0; k < 68; ++k)
+        points[k] = cv::Point2d(static_cast<double>(shape.part(k).x()), static_cast<double>(shape.part(k).y()));
+    return points;
+}
+
+FaceLandmarks LandmarkDetector::detect(const cv::Mat& bgr) const {
+    const std::vector<cv::Rect> faces = detectFaces(bgr);
+    if (faces.empty()) throw BoothError(ErrorKind::NoFace, "", "no face found (is the face in view, lit and frontal?)");
+    FaceLandmarks result;
+    result.face = faces.front();
+    result.facesFound = static_cast<int>(faces.size());
+    result.points = landmarksIn(bgr, result.face);
+    return result;
+}
+
+}  // namespace avatarbooth

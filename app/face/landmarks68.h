@@ -1,0 +1,45 @@
+// Front-photo face detection and dlib's 68-point landmarks (iBUG 300-W order), kept behind this small interface
+// so that dlib's heavy headers stay in one source file.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <array>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace avatarbooth {
+
+struct FaceLandmarks {
+    cv::Rect face;                          // the detector's box, in image pixels
+    std::array<cv::Point2d, 68> points{};   // iBUG order: jaw 0-16, brows 17-26, nose 27-35, eyes 36-47, mouth 48-67
+    int facesFound = 0;                     // how many faces the detector saw (the largest is used)
+};
+
+// Name of landmark k as used for feature vertices ("ibug_07").
+std::string landmarkName(int k);
+
+class LandmarkDetector {
+public:
+    // Loads dlib's HOG face detector and the shape predictor model (about 100 MB, 1-2 s): do it once.
+    // Throws BoothError(BadConfig) naming the model file when it is missing or unreadable.
+    explicit LandmarkDetector(const std::filesystem::path& shapePredictorModel);
+    ~LandmarkDetector();
+    LandmarkDetector(const LandmarkDetector&) = delete;
+    LandmarkDetector& operator=(const LandmarkDetector&) = delete;
+
+    // Face boxes in image pixels, largest first (detection runs on a copy scaled to at most 800 px).
+    std::vector<cv::Rect> detectFaces(const cv::Mat& bgr) const;
+    // The 68 points of the largest face; throws BoothError(NoFace) when there is none.
+    FaceLandmarks detect(const cv::Mat& bgr) const;
+    // The 68 points inside a given face box.
+    std::array<cv::Point2d, 68> landmarksIn(const cv::Mat& bgr, const cv::Rect& face) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace avatarbooth

@@ -1,0 +1,55 @@
+// The synthetic visitor: front and side photos of a head whose shape and landmarks are known exactly, so that
+// fitting can be checked against ground truth and the booth can be demonstrated without a camera.
+//
+// The head is the base head deformed by a smooth analytic warp (per-axis scaling, a wider or narrower jaw, a
+// longer or shorter nose, a fuller back of the head, a longer chin) whose form differs from the fit's RBF warp,
+// so that the fit cannot recover it exactly by construction. Its face is painted procedurally in texture space
+// (skin, hair cap, brows, eyes with iris and pupil, lips, nostrils) and lit by the renderer, well enough that
+// dlib's face detector and landmark predictor find it.
+#pragma once
+
+#include "head/base_head.h"
+#include "head/mesh.h"
+#include "render/mesh_renderer.h"
+
+#include <opencv2/core.hpp>
+
+#include <filesystem>
+#include <map>
+#include <string>
+
+namespace avatarbooth {
+
+struct SyntheticVisitorOptions {
+    unsigned seed = 1;              // picks the warp's coefficients (seed 0: no warp, the base head itself)
+    double mmPerPixel = 0.6;        // orthographic scale of both photos
+    cv::Size imageSize{972, 720};
+    bool sideNoseImageRight = true; // which way the profile faces in the side photo
+    int textureSize = 1024;
+};
+
+struct SyntheticVisitor {
+    cv::Mat front, side;   // the photos (BGR), the head composited on a backdrop with shoulders
+    cv::Mat background;    // the empty booth: the same backdrop without the person
+    cv::Mat texture;       // the painted face texture (base head UVs)
+    Mesh truthMesh;        // the visitor's head: the base head's topology, warped positions
+    RenderCamera frontCamera, sideCamera;
+    // Ground-truth 2-D landmarks in photo pixels (pixel centres at +0.5): the warped feature vertices projected.
+    std::map<std::string, cv::Point2d> frontLandmarks;  // ibug_00 .. ibug_67
+    std::map<std::string, cv::Point2d> sideLandmarks;   // profile names (nose_tip, chin, ...)
+};
+
+// The warp applied to base-head points for a given seed.
+glm::dvec3 syntheticWarp(const glm::dvec3& p, unsigned seed);
+
+// The procedural face texture for a base head (depends only on the base head).
+cv::Mat paintSyntheticFace(const BaseHead& base, int textureSize);
+
+SyntheticVisitor makeSyntheticVisitor(const BaseHead& base, MeshRenderer& renderer,
+                                      const SyntheticVisitorOptions& options = {});
+
+// Writes a recorded session folder: front.jpg, side.jpg, background.png and truth/ (head.glb with the texture,
+// landmarks.json with the ground-truth points and cameras).
+void writeSyntheticVisitorFolder(const SyntheticVisitor& visitor, const std::filesystem::path& dir);
+
+}  // namespace avatarbooth
