@@ -239,6 +239,7 @@ SyntheticVisitor makeSyntheticVisitor(const BaseHead& base, MeshRenderer& render
         v.frontLandmarks[name] = toPixel(v.frontCamera.project(v.truthMesh.positions[vertex]));
     for (const auto& [name, vertex] : base.sideFeatures)
         v.sideLandmarks[name] = toPixel(v.sideCamera.project(v.truthMesh.positions[vertex]));
+    v.sideLandmarks["ear_hole"] = toPixel(v.sideCamera.project(syntheticWarp(base.earHoleCentre, options.seed)));
     return v;
 }
 

@@ -1,8 +1,65 @@
-// `avatarbooth fit --front F --side S [--background B] -o OUT/`
+// `avatarbooth fit --front F --side S [--background B] -o OUT/`: one photo pair to a session folder.
 #include "cli/commands.h"
 
+#include "common/error.h"
+#include "pipeline/fit_pipeline.h"
+
+#include <iostream>
+
 namespace avatarbooth {
+
 void registerFitCommand(CLI::App& app) {
-    app.add_subcommand("fit", "Fit a 3-D head to a front and a side photo");
+    auto* cmd = app.add_subcommand("fit", "Fit a textured 3-D head to a front and a side photo");
+    struct Options {
+        FitInputs inputs;
+        std::string out;
+        std::string kernel = "ntt";
+        double unitMm = 23.0;
+        std::string model = AVATARBOOTH_DEFAULT_DLIB_MODEL;
+        std::string baseMesh, baseFeatures;
+        int textureSize = 1024;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("--front", o->inputs.front, "Front photo (JPEG or PNG)")->required();
+    cmd->add_option("--side", o->inputs.side, "Side (profile) photo; the nose may point either way")->required();
+    cmd->add_option("--background", o->inputs.background, "Photo of the empty booth (improves the silhouettes)");
+    cmd->add_option("-o,--output", o->out, "Output session folder (written completely or not at all)")->required();
+    cmd->add_option("--kernel", o->kernel, "RBF kernel: ntt (the paper's 1/(r+1)), tps, gaussian")->capture_default_str();
+    cmd->add_option("--rbf-unit-mm", o->unitMm, "Length of one unit of r, in mm")->capture_default_str();
+    cmd->add_option("--landmark-model", o->model, "dlib 68-point shape predictor (iBUG 300-W: non-commercial terms)")
+        ->capture_default_str();
+    cmd->add_option("--base-mesh", o->baseMesh, "Your own base head (glb with UVs) instead of the built-in one");
+    cmd->add_option("--base-features", o->baseFeatures, "Feature file of --base-mesh (see make-base-head)");
+    cmd->add_option("--texture-size", o->textureSize, "Texture size in texels")->capture_default_str()->check(CLI::Range(256, 4096));
+    cmd->callback([o] {
+        FitSettings settings;
+        try {
+            settings.head.rbf.kernel = parseRbfKernel(o->kernel);
+        } catch (const std::invalid_argument& e) {
+            throw BoothError(ErrorKind::BadConfig, "--kernel", e.what());
+        }
+        if (!(o->unitMm > 0.0)) throw BoothError(ErrorKind::BadConfig, "--rbf-unit-mm", "must be positive");
+        settings.head.rbf.unitMm = o->unitMm;
+        settings.landmarkModel = o->model;
+        settings.texture.size = o->textureSize;
+        if (o->baseMesh.empty() != o->baseFeatures.empty())
+            throw BoothError(ErrorKind::BadConfig, "--base-mesh/--base-features", "give both or neither");
+        std::unique_ptr<BaseHead> custom;
+        if (!o->baseMesh.empty()) custom = std::make_unique<BaseHead>(loadBaseHead(o->baseMesh, o->baseFeatures));
+        const FitPipeline pipeline(settings, custom ? *custom : builtinBaseHead());
+        const FitOutcome outcome = pipeline.fit(o->inputs);
+        MeshRenderer renderer;
+        const auto written = pipeline.write(outcome, o->inputs, o->out, renderer);
+        for (const auto& w : outcome.warnings) std::cerr << "avatarbooth: warning: " << w << "\n";
+        double seconds = 0.0;
+        for (const auto& [name, s] : outcome.stageSeconds) seconds += s;
+        std::cout << "avatar written to " << (std::filesystem::path(o->out) / "avatar.glb").string() << "\n"
+                  << "previews: " << (std::filesystem::path(o->out) / "preview_front.png").string() << ", preview_side.png, "
+                  << "preview_three_quarter.png\n"
+                  << "overlays: front_overlay.jpg, side_overlay.jpg; report: fit.json, landmarks.json\n"
+                  << "fit took " << static_cast<int>(seconds * 1000.0) << " ms (model loading "
+                  << static_cast<int>(pipeline.modelLoadSeconds() * 1000.0) << " ms apart)\n";
+    });
 }
+
 }  // namespace avatarbooth

@@ -17,11 +17,14 @@ int main(int argc, char** argv) {
     avatarbooth::registerFitCommand(app);
     avatarbooth::registerMakeBaseHeadCommand(app);
     avatarbooth::registerMakeVisitorCommand(app);
+    avatarbooth::registerBenchCommand(app);
     app.parse_complete_callback([&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::warn); });
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        // --help and --version are "errors" with code 0; every real usage error exits with 2.
+        const int code = app.exit(e);
+        return code == 0 ? avatarbooth::kExitOk : avatarbooth::kExitUsage;
     } catch (const avatarbooth::BoothError& e) {
         std::cerr << "avatarbooth: error: " << e.what() << "\n";
         return avatarbooth::exitCodeFor(e.kind());

@@ -42,9 +42,9 @@ LandmarkDetector::LandmarkDetector(const std::filesystem::path& model) : impl_(s
 LandmarkDetector::~LandmarkDetector() = default;
 
 std::vector<cv::Rect> LandmarkDetector::detectFaces(const cv::Mat& bgr) const {
-    // HOG detection costs grow with the pixel count; 800 px keeps a booth face (>= 150 px) well above dlib's
+    // HOG detection costs grow with the pixel count; 640 px keeps a booth face (>= 150 px) well above dlib's
     // 80 px minimum, and small photos are upsampled once so that small faces are still found.
-    constexpr int kMaxSide = 800;
+    constexpr int kMaxSide = 640;
     const double scale = std::min(1.0, static_cast<double>(kMaxSide) / std::max(bgr.cols, bgr.rows));
     cv::Mat grey;
     cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);

@@ -30,7 +30,7 @@ public:
     LandmarkDetector(const LandmarkDetector&) = delete;
     LandmarkDetector& operator=(const LandmarkDetector&) = delete;
 
-    // Face boxes in image pixels, largest first (detection runs on a copy scaled to at most 800 px).
+    // Face boxes in image pixels, largest first (detection runs on a copy scaled to at most 640 px).
     std::vector<cv::Rect> detectFaces(const cv::Mat& bgr) const;
     // The 68 points of the largest face; throws BoothError(NoFace) when there is none.
     FaceLandmarks detect(const cv::Mat& bgr) const;

@@ -1,0 +1,75 @@
+// `avatarbooth bench --front F --side S [-n N]`: per-stage wall times of the fit (medians over N runs), with
+// model loading reported apart. Prints figures; never fails on speed.
+#include "cli/commands.h"
+
+#include "common/image_io.h"
+#include "pipeline/fit_pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <thread>
+
+namespace avatarbooth {
+namespace {
+
+std::string cpuModel() {
+    std::ifstream in("/proc/cpuinfo");
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+    return "unknown CPU";
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+void registerBenchCommand(CLI::App& app) {
+    auto* cmd = app.add_subcommand("bench", "Time each stage of the fit on one photo pair (medians over runs)");
+    struct Options {
+        FitInputs inputs;
+        int runs = 5;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("--front", o->inputs.front, "Front photo")->required();
+    cmd->add_option("--side", o->inputs.side, "Side photo")->required();
+    cmd->add_option("--background", o->inputs.background, "Empty-booth photo");
+    cmd->add_option("-n,--runs", o->runs, "Runs (the first is a warm-up and not counted)")->capture_default_str()->check(CLI::Range(2, 1000));
+    cmd->callback([o] {
+        const FitPipeline pipeline{FitSettings{}};
+        const cv::Mat front = readPhoto(o->inputs.front), side = readPhoto(o->inputs.side);
+        const cv::Mat background = o->inputs.background.empty() ? cv::Mat() : readPhoto(o->inputs.background);
+        std::map<std::string, std::vector<double>> times;
+        std::vector<std::string> order;
+        std::vector<double> totals;
+        for (int i = 0; i < o->runs; ++i) {
+            const FitOutcome out = pipeline.fit(front, side, background, o->inputs);
+            if (i == 0) {
+                for (const auto& [name, s] : out.stageSeconds) order.push_back(name);
+                continue;  // warm-up: caches, lazy initialisation
+            }
+            double total = 0.0;
+            for (const auto& [name, s] : out.stageSeconds) {
+                times[name].push_back(s);
+                total += s;
+            }
+            totals.push_back(total);
+        }
+        std::cout << "machine: " << cpuModel() << ", " << std::thread::hardware_concurrency() << " threads\n"
+                  << "photos: front " << front.cols << "x" << front.rows << ", side " << side.cols << "x" << side.rows
+                  << "; " << o->runs - 1 << " timed runs (after one warm-up)\n"
+                  << "model loading (once, apart): " << static_cast<int>(pipeline.modelLoadSeconds() * 1000) << " ms\n";
+        for (const auto& name : order)
+            std::printf("  %-18s median %7.1f ms   worst %7.1f ms\n", name.c_str(), 1000 * median(times[name]),
+                        1000 * *std::max_element(times[name].begin(), times[name].end()));
+        std::printf("  %-18s median %7.1f ms   worst %7.1f ms   (target: under 300 ms)\n", "whole fit",
+                    1000 * median(totals), 1000 * *std::max_element(totals.begin(), totals.end()));
+    });
+}
+
+}  // namespace avatarbooth

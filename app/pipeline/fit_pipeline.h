@@ -1,0 +1,78 @@
+// The whole photo-to-head pipeline, as `avatarbooth fit` (and later the kiosk and batch runs) use it:
+// read photos -> front landmarks + silhouette -> side profile -> fit -> texture -> previews -> session folder.
+#pragma once
+
+#include "face/landmarks68.h"
+#include "head/base_head.h"
+#include "head/head_fit.h"
+#include "head/photo_texture.h"
+#include "render/mesh_renderer.h"
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace avatarbooth {
+
+struct FitSettings {
+    std::filesystem::path landmarkModel = AVATARBOOTH_DEFAULT_DLIB_MODEL;
+    HeadFitOptions head = defaultHeadFitOptions();
+    PhotoTextureOptions texture;
+    int previewSize = 512;
+};
+
+struct FitInputs {
+    std::filesystem::path front, side, background;  // background may be empty
+};
+
+// Everything one fit produced, in memory.
+struct FitOutcome {
+    cv::Mat front, side, background;
+    FaceLandmarks frontLandmarks;
+    cv::Mat frontMask;
+    std::map<std::string, cv::Point2d> sideLandmarks;
+    bool sideNoseImageRight = true;
+    cv::Mat sideMask;
+    HeadFit fit;
+    PhotoTexture texture;
+    std::vector<std::pair<std::string, double>> stageSeconds;  // in order
+    std::vector<std::string> warnings;
+};
+
+class FitPipeline {
+public:
+    // Loads the landmark model (1-2 s): build one pipeline and reuse it.
+    explicit FitPipeline(FitSettings settings, const BaseHead& base = builtinBaseHead());
+    ~FitPipeline();
+
+    double modelLoadSeconds() const { return modelLoadSeconds_; }
+    const BaseHead& baseHead() const { return base_; }
+
+    // Reads, analyses, fits and textures. Errors are BoothErrors naming the photo they concern.
+    FitOutcome fit(const FitInputs& inputs) const;
+    // The same on photos already in memory (names are used in error messages).
+    FitOutcome fit(const cv::Mat& front, const cv::Mat& side, const cv::Mat& background,
+                   const FitInputs& names = {}) const;
+
+    // Writes the session folder atomically: it is complete, or absent (an earlier result stays as it was).
+    // Returns the paths of what was written. The renderer makes the previews.
+    std::vector<std::filesystem::path> write(const FitOutcome& outcome, const FitInputs& inputs,
+                                             const std::filesystem::path& out, MeshRenderer& renderer) const;
+
+private:
+    FitSettings settings_;
+    const BaseHead& base_;
+    std::unique_ptr<LandmarkDetector> detector_;
+    double modelLoadSeconds_ = 0.0;
+};
+
+// Drawings for a person to check the analysis: landmarks, silhouette outline, contour rays.
+cv::Mat drawFrontOverlay(const FitOutcome& outcome);
+cv::Mat drawSideOverlayWithRays(const FitOutcome& outcome);
+
+}  // namespace avatarbooth

@@ -1,0 +1,61 @@
+// All eight FRMDB people (real photos, dark hair on a dark backdrop) fit without error, with both profile
+// directions; the overlays and previews are written for a person to look at.
+#include "test_paths.h"
+
+#include "export/glb.h"
+#include "pipeline/fit_pipeline.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+namespace fs = std::filesystem;
+using namespace avatarbooth;
+
+namespace {
+
+const FitPipeline& pipeline() {
+    static const FitPipeline p{FitSettings{}};
+    return p;
+}
+
+MeshRenderer& renderer() {
+    static MeshRenderer r;
+    return r;
+}
+
+}  // namespace
+
+class FrmdbFit : public ::testing::TestWithParam<std::tuple<int, const char*>> {};
+
+TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
+    AVATARBOOTH_REQUIRE_SHARED_DATA();
+    char person[8];
+    std::snprintf(person, sizeof person, "%03d", std::get<0>(GetParam()));
+    const fs::path dir = test::sharedData() / "frmdb" / person;
+    const FitInputs inputs{dir / "Img_33.jpg", dir / std::get<1>(GetParam()), {}};
+    const FitOutcome outcome = pipeline().fit(inputs);
+    const fs::path out = test::scratchDir(std::string("frmdb_") + person + "_" + std::get<1>(GetParam())) / "session";
+    pipeline().write(outcome, inputs, out, renderer());
+    std::printf("%s %s: overlays and previews in %s (%zu warnings)\n", person, std::get<1>(GetParam()), out.c_str(),
+                outcome.warnings.size());
+    EXPECT_TRUE(fs::exists(out / "front_overlay.jpg"));
+    EXPECT_TRUE(fs::exists(out / "side_overlay.jpg"));
+    // The fitted head is a plausible adult head: 19-30 cm from the top (hair included) to the chin.
+    const Mesh& mesh = outcome.fit.mesh;
+    glm::dvec3 lo, hi;
+    mesh.bounds(lo, hi);
+    EXPECT_GT(hi.x - lo.x, 120.0);
+    EXPECT_LT(hi.x - lo.x, 260.0);
+    EXPECT_EQ(outcome.sideNoseImageRight, std::string(std::get<1>(GetParam())) == "Img_53.jpg");
+    // The glb reads back with the same mesh.
+    const Mesh back = readGlbMesh(out / "avatar.glb");
+    EXPECT_EQ(back.positions.size(), mesh.positions.size());
+}
+
+INSTANTIATE_TEST_SUITE_P(AllPeople, FrmdbFit,
+                         ::testing::Combine(::testing::Range(1, 9), ::testing::Values("Img_13.jpg", "Img_53.jpg")),
+                         [](const ::testing::TestParamInfo<std::tuple<int, const char*>>& p) {
+                             return "person" + std::to_string(std::get<0>(p.param)) +
+                                    (std::string(std::get<1>(p.param)) == "Img_13.jpg" ? "_nose_left" : "_nose_right");
+                         });

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Set-up shared by the README's two commands: installs the Debian packages that are missing (as root, with
+# apt-get), installs the glTF validator from npm into tests/gltf/, and builds the project with CMake.
+# Usage: tests/setup.sh [PRESET]   (default: release; CI uses "ci", which turns warnings into errors)
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+preset="${1:-release}"
+
+packages=(
+  build-essential cmake pkg-config git
+  libopencv-dev opencv-data libdlib-dev libdlib-data
+  libtinygltf-dev nlohmann-json3-dev libglm-dev
+  libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri
+  libcli11-dev libspdlog-dev libtomlplusplus-dev libsystemd-dev libgpiod-dev libcamera-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  nodejs npm
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+# npm may come from outside Debian (a machine with Node.js already set up): then it is not missing.
+if command -v npm >/dev/null 2>&1; then
+  missing=("${missing[@]/npm}"); missing=("${missing[@]/nodejs}")
+fi
+read -r -a missing <<<"${missing[*]:-}"
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  if [ "$(id -u)" -ne 0 ]; then echo "setup: run as root (apt-get needs it) or install: ${missing[*]}" >&2; exit 1; fi
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+if [ ! -d "$root/tests/gltf/node_modules/gltf-validator" ]; then
+  echo "setup: installing the Khronos glTF validator (npm)"
+  (cd "$root/tests/gltf" && npm ci --no-audit --no-fund --loglevel=error)
+fi
+
+echo "setup: building ($preset)"
+cmake --preset "$preset" -S "$root" >/dev/null
+cmake --build --preset "$preset" -j "$(nproc)"
