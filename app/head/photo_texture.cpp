@@ -55,7 +55,7 @@ cv::Mat samplePhoto(const cv::Mat& photo, const cv::Mat& mask, const cv::Mat& ma
 PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
                                const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options) {
     const cv::Size size(options.size, options.size);
-    const SurfaceTexels texels = sampleSurfaceTexels(fitted, fitted.vertexNormals(), size);
+    const SurfaceTexels texels = sampleSurfaceTexels(fitted, fitted.vertexNormals(), cachedTexelMap(fitted, size));
     cv::Mat fx(size, CV_32F), fy(size, CV_32F), sx(size, CV_32F), sy(size, CV_32F);
     cv::Mat wFront(size, CV_32F, cv::Scalar(0)), wSide(size, CV_32F, cv::Scalar(0));
     for (int y = 0; y < size.height; ++y) {
@@ -69,10 +69,11 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
             sx.at<float>(y, x) = static_cast<float>(s.x);
             sy.at<float>(y, x) = static_cast<float>(s.y);
             if (!texels.covered.at<unsigned char>(y, x)) continue;
+            const auto strict = [&](double c) { return options.angleStrictness == 2.0 ? c * c : std::pow(c, options.angleStrictness); };
             // The front photo sees surfaces facing +z; the side photo sees one side, and stands in (mirrored) for
             // the other: the orthographic side view of (z, y) is the same for x and -x.
-            wFront.at<float>(y, x) = static_cast<float>(std::pow(std::max(0.0f, n[2]), options.angleStrictness));
-            wSide.at<float>(y, x) = static_cast<float>(std::pow(std::abs(n[0]), options.angleStrictness));
+            wFront.at<float>(y, x) = static_cast<float>(strict(std::max(0.0f, n[2])));
+            wSide.at<float>(y, x) = static_cast<float>(strict(std::abs(n[0])));
         }
     }
     cv::Mat frontValid, sideValid;
