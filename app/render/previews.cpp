@@ -1,0 +1,71 @@
+// Front, side and three-quarter previews: orthographic views framed to the mesh, lit, on grey.
+#include "render/previews.h"
+
+#include "common/error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace avatarbooth {
+namespace {
+
+constexpr double kMargin = 0.06;                    // of the framed extent, on each side
+const cv::Scalar kBackground(128, 128, 128);        // neutral grey (BGR)
+
+// An orthographic camera looking along -direction at the mesh, fitted to the mesh's extent in that view.
+RenderCamera framedCamera(const Mesh& mesh, glm::dvec3 direction, glm::dvec3 up, int size) {
+    glm::dvec3 lo, hi;
+    mesh.bounds(lo, hi);
+    const glm::dvec3 centre = (lo + hi) * 0.5;
+    const double radius = std::max(glm::length(hi - lo) * 0.5, 1.0);
+    const glm::dvec3 back = glm::normalize(direction);  // from the mesh towards the camera
+    const glm::dvec3 right = glm::normalize(glm::cross(up, back));
+    const glm::dvec3 trueUp = glm::cross(back, right);
+    double minX = std::numeric_limits<double>::max(), maxX = std::numeric_limits<double>::lowest();
+    double minY = minX, maxY = maxX;
+    for (const auto& p : mesh.positions) {
+        const glm::dvec3 d = p - centre;
+        const double x = glm::dot(d, right), y = glm::dot(d, trueUp);
+        minX = std::min(minX, x);
+        maxX = std::max(maxX, x);
+        minY = std::min(minY, y);
+        maxY = std::max(maxY, y);
+    }
+    const double extent = std::max({maxX - minX, maxY - minY, 1e-3});
+    const glm::dvec3 target = centre + right * (0.5 * (minX + maxX)) + trueUp * (0.5 * (minY + maxY));
+    const double mmPerPixel = extent * (1.0 + 2.0 * kMargin) / size;
+    RenderCamera camera =
+        RenderCamera::orthographic(target + back * (2.0 * radius + 100.0), target, trueUp, mmPerPixel, size, size);
+    camera.background = kBackground;
+    camera.lit = true;
+    return camera;
+}
+
+}  // namespace
+
+PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size) {
+    if (mesh.positions.empty() || mesh.triangles.empty())
+        throw BoothError(ErrorKind::Internal, "", "previews: the mesh is empty");
+    if (renderer.vertexCount() != mesh.positions.size() || renderer.triangleCount() != mesh.triangles.size())
+        throw BoothError(ErrorKind::Internal, "",
+                         "previews: the mesh is not the one uploaded to the renderer (" +
+                             std::to_string(mesh.positions.size()) + " vertices, " +
+                             std::to_string(mesh.triangles.size()) + " triangles; the renderer holds " +
+                             std::to_string(renderer.vertexCount()) + " and " +
+                             std::to_string(renderer.triangleCount()) + ")");
+    if (size <= 0) throw BoothError(ErrorKind::Internal, "", "previews: size must be positive");
+
+    const glm::dvec3 up(0.0, 1.0, 0.0);
+    const double elevation = glm::radians(15.0);
+    const glm::dvec3 threeQuarter(-std::sin(glm::radians(45.0)) * std::cos(elevation), std::sin(elevation),
+                                  std::cos(glm::radians(45.0)) * std::cos(elevation));
+    PreviewSet set;
+    set.front = renderer.render(framedCamera(mesh, {0.0, 0.0, 1.0}, up, size)).bgr;
+    set.side = renderer.render(framedCamera(mesh, {-1.0, 0.0, 0.0}, up, size)).bgr;
+    set.threeQuarter = renderer.render(framedCamera(mesh, threeQuarter, up, size)).bgr;
+    return set;
+}
+
+}  // namespace avatarbooth

@@ -1,0 +1,23 @@
+// Preview images of a fitted head (front, side, three-quarter) for the reveal screen and the session folder.
+#pragma once
+
+#include "head/mesh.h"
+#include "render/mesh_renderer.h"
+
+#include <opencv2/core.hpp>
+
+namespace avatarbooth {
+
+struct PreviewSet {
+    cv::Mat front;         // camera on +z, looking at the face
+    cv::Mat side;          // camera on -x: the subject's right side
+    cv::Mat threeQuarter;  // 45 degrees between the two, slightly above
+};
+
+// Lit, orthographic, square (size x size, BGR) renders of the mesh the renderer holds, each framed to the mesh's
+// extent in that view with a small margin, on a neutral grey background. `mesh` must be the mesh last uploaded to
+// `renderer` (with its texture); it is used for framing. Throws BoothError(Internal) when it is empty or is not
+// the uploaded one.
+PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size = 512);
+
+}  // namespace avatarbooth
