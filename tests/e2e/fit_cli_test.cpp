@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <fstream>
 
+#include <unistd.h>
+
 namespace fs = std::filesystem;
 using namespace avatarbooth::test;
 
@@ -31,10 +33,11 @@ CommandResult run(const std::string& args) {
     return r;
 }
 
-// One synthetic visitor for all tests in this file (rendering costs a second).
+// One synthetic visitor per test process (rendering costs a second); ctest runs each test in its own process,
+// several at once, so the folder is the process's own.
 const fs::path& visitor() {
     static const fs::path dir = [] {
-        const fs::path d = scratchDir("e2e_visitor") / "visitor";
+        const fs::path d = scratchDir("e2e_visitor_" + std::to_string(getpid())) / "visitor";
         const CommandResult r = run("make-visitor --seed 2 -o " + d.string());
         EXPECT_EQ(r.exitCode, 0) << r.output;
         return d;
