@@ -1,0 +1,81 @@
+// Side-photo analysis: the head's profile outline, which way it faces, and the profile landmarks (METHODS.md §1, §4).
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace avatarbooth {
+
+// A named 2-D point of a profile, in the frame of the outline it was found on.
+struct ProfilePoint {
+    std::string name;
+    cv::Point2d px;
+};
+
+// The names findProfileLandmarks returns, top to bottom, then the back of the head and the ear hole estimate.
+// (Soft-tissue anthropometric points: vertex, a forehead point, glabella, nasion, pronasale, subnasale, labrale
+// superius, labrale inferius, pogonion, cervical point, opisthocranion, porion estimate.)
+inline constexpr std::string_view kProfileLandmarkNames[] = {
+    "top_of_head", "forehead", "glabella", "nasion", "nose_tip", "subnasale", "upper_lip",
+    "lower_lip",   "chin",     "throat",   "back_of_head", "ear_hole"};
+
+// The result of fitting the landmark model to an outline, with how sure it is.
+struct ProfileFit {
+    bool ok = false;
+    std::string failure;                  // why not, when !ok
+    std::vector<ProfilePoint> landmarks;  // in kProfileLandmarkNames order when ok
+    // min(nose depth above, nose depth below) / (nose tip height below the top of head): about 0.1 for a real
+    // profile (a 2 cm nose on a 14.5 cm vertex-to-nose-tip height), near 0 for a front view's silhouette.
+    double noseProminence = 0.0;
+    std::vector<std::string> warnings;    // points that were estimated rather than found
+};
+
+// Finds the profile landmarks on a head's closed silhouette outline (METHODS §4: extrema and concavities of the
+// profile). The outline is in an image-like frame: y points down, the face points +x (image right), or -x when
+// noseRight is false (the outline is then mirrored, fitted, and the answers mirrored back); any start point,
+// either winding, any unit (image pixels, or millimetres of a base head's mid-sagittal line); it may carry the
+// neck, shoulders and the image's bottom edge. Pure function. See profile.cpp for each point's definition and
+// every constant.
+ProfileFit fitProfile(const std::vector<cv::Point2d>& outline, bool noseRight = true);
+
+// As fitProfile, returning the landmarks; throws BoothError(NoFace) with the reason when no profile is found.
+// Warnings (estimated points) are appended to *warnings when given.
+std::vector<ProfilePoint> findProfileLandmarks(const std::vector<cv::Point2d>& outline, bool noseRight = true,
+                                               std::vector<std::string>* warnings = nullptr);
+
+// The point called `name`; throws BoothError(Internal) when it is missing.
+cv::Point2d profilePoint(const std::vector<ProfilePoint>& points, std::string_view name);
+
+struct SideAnalysis {
+    cv::Mat mask;                        // CV_8U, 255 on the person (see segmentPerson)
+    bool noseImageRight = true;          // the subject faces image-right
+    std::vector<cv::Point2d> outline;    // the silhouette's outline, original image coordinates
+    std::vector<ProfilePoint> landmarks; // kProfileLandmarkNames, original image coordinates
+    std::vector<std::string> warnings;
+};
+
+struct SideOptions {
+    // Folder of OpenCV's haarcascades (the LBP cascades are looked for in ../lbpcascades beside it); empty: the
+    // build's default (/usr/share/opencv4/haarcascades from opencv-data).
+    std::filesystem::path cascadeDir;
+    // Run the frontal-face detector on the head and refuse a front view (about 5 ms).
+    bool rejectFrontViews = true;
+};
+
+// Analyses a side photo: silhouette (with the empty-booth plate when not empty), facing direction (either way
+// works: the outline is fitted both ways, a nose pointing left is fitted mirrored and the points mapped back),
+// profile landmarks.
+// Throws BoothError: BadInput (empty/odd image), NoFace (nothing stands out from the background),
+// Mismatch "this looks like a front view, not a profile" when a frontal face is detected on the head or neither
+// side of the silhouette has a nose.
+SideAnalysis analyzeSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate = cv::Mat(),
+                              const SideOptions& options = {});
+
+// Draws the outline and the named landmarks (and warnings) on a BGR canvas of the photo's size.
+void drawSideOverlay(cv::Mat& canvas, const SideAnalysis& analysis);
+
+}  // namespace avatarbooth
