@@ -7,7 +7,8 @@
 //                 (see noseCandidate) and is the most forward of those that pass.
 //   nasion        the deepest point of the concavity between the forehead and the nose: first the deepest point
 //                 under the chord from the profile point 0.45 V above the nose tip to the nose tip (the nasion sits
-//                 about 0.31 V above it), then again under the chord from the glabella to the nose tip.
+//                 0.20-0.26 V above it on the sample profiles), then again under the chord from the glabella to the
+//                 nose tip.
 //   glabella      the most forward point of the brow within 0.2 V (~3 cm) above the nasion.
 //   forehead      the profile point half-way in height between the top of the head and the glabella.
 //   subnasale     the deepest point under the chord from the nose tip to the upper lip.
@@ -50,15 +51,15 @@ constexpr double kCandidateHysteresis = 0.002;
 // Hysteresis for the lips and chin, once the scale V is known: 0.006 V (about 0.9 mm).
 constexpr double kFeatureHysteresis = 0.006;
 // A nose stands out from the profile by at least 3.5% of V on both sides (5 mm; real noses: 15-25 mm above,
-// 12-20 mm below). A front view's silhouette has nothing like it.
+// 12-20 mm below). A front view's silhouette rarely has one; the plausibility checks in fitProfile catch the rest.
 constexpr double kMinNoseProminence = 0.035;
 // The head around a nose candidate must be at least 0.8 V long at half its height (real heads: ~1.3 V). This
 // keeps the chest or a shoulder, far below the head, from passing as a nose.
 constexpr double kMinHeadLengthOverV = 0.8;
 // Direction the chin is looked for along: 20 degrees below forward. A chin outline receding at less than 20 degrees
 // from the vertical still yields its lowest forward point, and the under-chin (running back at 45-80 degrees) and
-// bumps under the jaw score lower; a lower lip scores lower unless it stands 0.36x its height above the chin in
-// front of it (handled below).
+// bumps under the jaw score lower; a lower lip scores higher only when it stands in front of the chin by more than
+// 0.36 times its height above it (handled below).
 constexpr double kChinTilt = 20.0 * CV_PI / 180.0;
 
 // ---------------------------------------------------------------------------------------------- curve helpers
@@ -104,7 +105,8 @@ Curve smoothClosed(const Curve& c, double sigma) {
     Curve out(c.size());
     for (int i = 0; i < n; ++i) {
         cv::Point2d acc(0.0, 0.0);
-        for (int d = -r; d <= r; ++d) acc += c[static_cast<std::size_t>(((i + d) % n + n) % n)] * k[static_cast<std::size_t>(d + r)];
+        for (int d = -r; d <= r; ++d)
+            acc += c[static_cast<std::size_t>(((i + d) % n + n) % n)] * k[static_cast<std::size_t>(d + r)];
         out[static_cast<std::size_t>(i)] = acc;
     }
     return out;
@@ -237,7 +239,7 @@ struct NoseChoice {
 
 // The nose tip: among the forward bulges of the front chain (local maxima of x), those that stand out by
 // kMinNoseProminence * V on both sides (V = their own height below the top: the candidate's own scale) within
-// 0.4 V above (the nasion is 0.31 V above the tip) and 0.3 V below (subnasale and lips), on a head at least
+// 0.4 V above (the nasion is 0.20-0.26 V above the tip) and 0.3 V below (subnasale and lips), on a head at least
 // kMinHeadLengthOverV * V long at half that height; the most forward of those.
 NoseChoice noseCandidate(const Chain& f, double yTop, const WidthProfile& widths, double outlineHeight) {
     NoseChoice best;
@@ -440,7 +442,8 @@ ProfileFit fitProfile(const std::vector<cv::Point2d>& outlineIn, bool noseRight)
         iLower = argmaxX(f, iMid, walkToLevel(f, iChin, -1, f.y(iChin) - 0.1 * V));
         warn("lips not found as bulges: set at the most forward points of the upper and lower half of the mouth");
     }
-    if (!(iNose < iUpper && iUpper < iLower && iLower < iChin)) return fail("the mouth between nose and chin is too small");
+    if (!(iNose < iUpper && iUpper < iLower && iLower < iChin))
+        return fail("the mouth between nose and chin is too small");
     const int iSubnasale = deepestUnderChord(f, iNose, iUpper);
 
     // --- back of the head: the most backward point of the back chain in its band, the middle of the run within
@@ -518,9 +521,9 @@ namespace {
 class FrontalFaceCheck {
 public:
     explicit FrontalFaceCheck(const std::filesystem::path& dir) {
-        const std::filesystem::path candidates[] = {dir.parent_path() / "lbpcascades" / "lbpcascade_frontalface_improved.xml",
-                                                    dir / "lbpcascade_frontalface_improved.xml",
-                                                    dir / "haarcascade_frontalface_alt2.xml"};
+        const std::filesystem::path candidates[] = {
+            dir.parent_path() / "lbpcascades" / "lbpcascade_frontalface_improved.xml",
+            dir / "lbpcascade_frontalface_improved.xml", dir / "haarcascade_frontalface_alt2.xml"};
         for (const auto& c : candidates) {
             std::error_code ec;
             if (std::filesystem::is_regular_file(c, ec) && cascade_.load(c.string())) {
@@ -613,6 +616,15 @@ SideAnalysis analyzeSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate
         out.warnings.push_back("facing direction uncertain: both sides of the outline have a nose-like bulge");
     out.noseImageRight = useRight;
     out.landmarks = fit.landmarks;
+    // A head cut by the frame still fits, but its cut side is the frame's edge, not the head's.
+    const cv::Rect box = cv::boundingRect(out.mask);
+    if (box.y <= 0) out.warnings.push_back("the head runs out of the photo at the top: top of head unreliable");
+    const int headTop = std::max(0, box.y);
+    const int headBottom = std::clamp(cvRound(profilePoint(out.landmarks, "throat").y), headTop, out.mask.rows - 1);
+    const cv::Range headRows(headTop, headBottom + 1);
+    if (cv::countNonZero(out.mask(headRows, cv::Range(0, 1))) > 0 ||
+        cv::countNonZero(out.mask(headRows, cv::Range(out.mask.cols - 1, out.mask.cols))) > 0)
+        out.warnings.push_back("the head runs out of the photo at the side: face or back of head may be cut");
     out.warnings.insert(out.warnings.end(), fit.warnings.begin(), fit.warnings.end());
     return out;
 }

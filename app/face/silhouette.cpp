@@ -32,8 +32,8 @@ constexpr int kLevelsC2 = 16;
 constexpr int kBins = kLevelsI * kLevelsC1 * kLevelsC2;
 constexpr std::array<int, 3> kAxisLevels{kLevelsI, kLevelsC1, kLevelsC2};
 constexpr std::array<int, 3> kAxisStrides{kLevelsC1 * kLevelsC2, kLevelsC2, 1};
-// Working copy: long side about 480 px (reduced by a whole factor: 486 px for 972, 400 for 1200). Faces in booth photos are then about 100 px wide, enough for the outline;
-// the full-resolution band refinement restores the edge.
+// Working copy: long side about 480 px (reduced by a whole factor: 486 px for 972, 400 for 1200). Faces in booth
+// photos are then about 100 px wide, enough for the outline; the full-resolution band refinement restores the edge.
 constexpr double kWorkLongSide = 480.0;
 // Log-likelihood ratios are clamped to +-kMaxLlr so one odd colour cannot dominate the smoothing.
 constexpr float kMaxLlr = 8.0f;

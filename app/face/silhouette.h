@@ -15,6 +15,10 @@ namespace avatarbooth {
 // borders (the person is assumed to touch at most the bottom border) and the person's colours from the head.
 // Both then alternate a colour-model relabelling with cleaning (largest component, holes filled) on a copy at
 // about 480 px, and relabel a band around the coarse edge at full resolution (see silhouette.cpp).
+// Without a plate the person's colours are seeded from warm colours (skin; brown, black, blond, red hair) unlike
+// the border: clothes in cold colours are found only where they differ clearly from the backdrop (a teal jumper on
+// a blue cloth is left out; a lit fold of the cloth next to the face is then also kept out, which matters more for
+// the profile). With a plate, clothes of any colour are found.
 // headHint: a box on the face (the front detector's box, or a profile-face box) or empty; when given, the
 // component overlapping it is the person and its colours seed the person's colour model.
 // Throws BoothError(BadInput) for an empty or non-BGR image or a plate of another size, BoothError(NoFace)
