@@ -47,6 +47,13 @@ double ellipsoid(const glm::dvec3& p, const glm::dvec3& centre, const glm::dvec3
     return k0 * (k0 - 1.0) / k1;
 }
 
+// Signed distance to a capsule: the segment a-b thickened by radius r.
+double capsule(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, double r) {
+    const glm::dvec3 ab = b - a;
+    const double t = std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0);
+    return glm::distance(p, a + t * ab) - r;
+}
+
 // A vertical elliptic cylinder from y0 to y1, rounded at the ends.
 double neck(const glm::dvec3& p) {
     const glm::dvec3 c(0.0, 0.0, -12.0);
@@ -65,9 +72,9 @@ double headField(const glm::dvec3& p) {
     d = smoothMin(d, ellipsoid(p, {0, -30, 22}, {63, 70, 68}), 15.0);               // face and jaw mass
     d = smoothMin(d, ellipsoid(p, {0, -88, 62}, {30, 24, 28}), 12.0);               // chin
     d = smoothMin(d, neck(p), 20.0);                                                 // neck
-    d = smoothMin(d, ellipsoid(p, {0, 26, 74}, {58, 13, 20}), 10.0);                // brow ridge
+    d = smoothMin(d, ellipsoid(p, {0, 26, 76}, {58, 13, 20}), 10.0);                // brow ridge
     d = smoothMin(d, ellipsoid(mirrored, {40, -22, 58}, {26, 24, 26}), 12.0);       // cheeks
-    d = smoothMin(d, ellipsoid(p, {0, -12, 90}, {10, 30, 14}), 6.0);                // nose bridge
+    d = smoothMin(d, capsule(p, {0, 4, 83}, {0, -29, 100}, 8.0), 5.0);             // nose bridge: straight, from below the nasion dip
     d = smoothMin(d, ellipsoid(p, {0, -33, 98}, {14, 11, 13}), 5.0);                // nose tip
     d = smoothMin(d, ellipsoid(mirrored, {13, -38, 88}, {8, 7, 8}), 4.0);           // alae (nostril wings)
     d = smoothMin(d, ellipsoid(p, {0, -57, 86}, {25, 7, 10}), 4.0);                 // upper lip
