@@ -65,6 +65,28 @@ const cv::Point2d& need(const std::map<std::string, cv::Point2d>& points, const 
     return it->second;
 }
 
+// The feature and contour vertices one view measures, with their targets in that view's plane (METHODS §1 steps
+// 3-4) and the displacements the RBF system of step 5 must reproduce. A vertex is measured once per view.
+struct ViewTargets {
+    explicit ViewTargets(View v) : view(v) {}
+    View view;
+    std::vector<glm::dvec3> centres;
+    std::vector<std::vector<double>> displacements;
+    std::vector<std::uint32_t> vertices;
+    std::vector<std::pair<std::string, glm::dvec2>> targets;
+    std::set<std::uint32_t> used;
+
+    void add(const Mesh& mesh, const std::string& name, std::uint32_t v, const glm::dvec2& target) {
+        if (!used.insert(v).second) return;
+        const glm::dvec3 c = mesh.positions[v];
+        const glm::dvec2 now = projectToView(c, view);
+        centres.push_back(c);
+        displacements.push_back({target.x - now.x, target.y - now.y});
+        vertices.push_back(v);
+        targets.emplace_back(name, target);
+    }
+};
+
 }  // namespace
 
 glm::dvec2 PhotoFrame::toHead(const cv::Point2d& px) const {
@@ -175,27 +197,9 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     fit.side.mirrored = mirror;
 
     // --- Steps 3-4: targets for the feature and contour vertices.
-    std::vector<glm::dvec3> frontCentres, sideCentres;
-    std::vector<std::vector<double>> frontDisp, sideDisp;
-    std::vector<std::uint32_t> frontVertices, sideVertices;
-    std::vector<std::pair<std::string, glm::dvec2>> frontTargets, sideTargets;
-    std::set<std::uint32_t> usedFront, usedSide;
-    const auto addFront = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) {
-        if (!usedFront.insert(v).second) return;
-        const glm::dvec3 c = s.positions[v];
-        frontCentres.push_back(c);
-        frontDisp.push_back({target.x - c.x, target.y - c.y});
-        frontVertices.push_back(v);
-        frontTargets.emplace_back(name, target);
-    };
-    const auto addSide = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) {
-        if (!usedSide.insert(v).second) return;
-        const glm::dvec3 c = s.positions[v];
-        sideCentres.push_back(c);
-        sideDisp.push_back({target.x - c.z, target.y - c.y});
-        sideVertices.push_back(v);
-        sideTargets.emplace_back(name, target);
-    };
+    ViewTargets frontT(View::Front), sideT(View::Side);
+    const auto addFront = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) { frontT.add(s, name, v, target); };
+    const auto addSide = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) { sideT.add(s, name, v, target); };
     for (const int k : options.frontLandmarks) {
         const std::string name = ibug(k);
         addFront(name, base.frontFeatures.at(name), fit.front.toHead(fp.at(name)));
@@ -223,8 +227,8 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     }
 
     // --- Step 5: the RBF warps, (x, y) from the front and (z, y) from the side, merged.
-    const RbfWarp frontWarp(frontCentres, frontDisp, options.rbf);
-    const RbfWarp sideWarp(sideCentres, sideDisp, options.rbf);
+    const RbfWarp frontWarp(frontT.centres, frontT.displacements, options.rbf);
+    const RbfWarp sideWarp(sideT.centres, sideT.displacements, options.rbf);
     const auto normals = s.vertexNormals();
     fit.mesh = s;
     for (std::size_t i = 0; i < s.positions.size(); ++i) {
@@ -240,16 +244,12 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     // The blend leaves feature vertices a little off their measured y. A last warp over all feature vertices (with
     // the same kernel) moves each onto its y exactly; a vertex measured in both photos takes the mean of the two.
     std::map<std::uint32_t, std::pair<double, int>> yTargets;
-    for (std::size_t k = 0; k < frontVertices.size(); ++k) {
-        auto& t = yTargets[frontVertices[k]];
-        t.first += frontTargets[k].second.y;
-        ++t.second;
-    }
-    for (std::size_t k = 0; k < sideVertices.size(); ++k) {
-        auto& t = yTargets[sideVertices[k]];
-        t.first += sideTargets[k].second.y;
-        ++t.second;
-    }
+    for (const ViewTargets* view : {&frontT, &sideT})
+        for (std::size_t k = 0; k < view->vertices.size(); ++k) {
+            auto& t = yTargets[view->vertices[k]];
+            t.first += view->targets[k].second.y;
+            ++t.second;
+        }
     std::vector<glm::dvec3> yCentres;
     std::vector<std::vector<double>> yDisp;
     for (const auto& [v, t] : yTargets) {
@@ -259,16 +259,12 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     const RbfWarp yWarp(yCentres, yDisp, options.rbf);
     for (auto& p : fit.mesh.positions) p.y += yWarp.evaluate(p)[0];
 
-    for (std::size_t k = 0; k < frontVertices.size(); ++k) {
-        const glm::dvec3 q = fit.mesh.positions[frontVertices[k]];
-        const glm::dvec2 t = frontTargets[k].second;
-        fit.residuals.push_back({frontTargets[k].first, "front", t, {q.x, q.y}, glm::distance(t, glm::dvec2(q.x, q.y))});
-    }
-    for (std::size_t k = 0; k < sideVertices.size(); ++k) {
-        const glm::dvec3 q = fit.mesh.positions[sideVertices[k]];
-        const glm::dvec2 t = sideTargets[k].second;
-        fit.residuals.push_back({sideTargets[k].first, "side", t, {q.z, q.y}, glm::distance(t, glm::dvec2(q.z, q.y))});
-    }
+    for (const ViewTargets* view : {&frontT, &sideT})
+        for (std::size_t k = 0; k < view->vertices.size(); ++k) {
+            const glm::dvec2 q = projectToView(fit.mesh.positions[view->vertices[k]], view->view);
+            const glm::dvec2 t = view->targets[k].second;
+            fit.residuals.push_back({view->targets[k].first, view->view == View::Front ? "front" : "side", t, q, glm::distance(t, q)});
+        }
     return fit;
 }
 

@@ -124,29 +124,33 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     return out;
 }
 
-cv::Mat drawFrontOverlay(const FitOutcome& o) {
-    cv::Mat canvas = o.front.clone();
+namespace {
+
+// The silhouette's outline and the contour rays (METHODS §1 step 4) drawn on a copy of a photo.
+cv::Mat drawOutlineAndRays(const cv::Mat& photo, const cv::Mat& mask,
+                           const std::vector<std::pair<cv::Point2d, cv::Point2d>>& rays) {
+    cv::Mat canvas = photo.clone();
     std::vector<std::vector<cv::Point>> contours;
-    cv::findContours(o.frontMask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+    cv::findContours(mask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
     cv::drawContours(canvas, contours, -1, cv::Scalar(255, 255, 0), 2, cv::LINE_AA);
-    for (const auto& [from, to] : o.fit.frontRays) {
+    for (const auto& [from, to] : rays) {
         cv::line(canvas, from, to, cv::Scalar(0, 220, 255), 1, cv::LINE_AA);
         cv::circle(canvas, to, 4, cv::Scalar(0, 140, 255), cv::FILLED, cv::LINE_AA);
     }
+    return canvas;
+}
+
+}  // namespace
+
+cv::Mat drawFrontOverlay(const FitOutcome& o) {
+    cv::Mat canvas = drawOutlineAndRays(o.front, o.frontMask, o.fit.frontRays);
     cv::rectangle(canvas, o.frontLandmarks.face, cv::Scalar(255, 0, 255), 1);
     for (const auto& p : o.frontLandmarks.points) cv::circle(canvas, p, 2, cv::Scalar(0, 255, 0), cv::FILLED, cv::LINE_AA);
     return canvas;
 }
 
 cv::Mat drawSideOverlayWithRays(const FitOutcome& o) {
-    cv::Mat canvas = o.side.clone();
-    std::vector<std::vector<cv::Point>> contours;
-    cv::findContours(o.sideMask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
-    cv::drawContours(canvas, contours, -1, cv::Scalar(255, 255, 0), 2, cv::LINE_AA);
-    for (const auto& [from, to] : o.fit.sideRays) {
-        cv::line(canvas, from, to, cv::Scalar(0, 220, 255), 1, cv::LINE_AA);
-        cv::circle(canvas, to, 4, cv::Scalar(0, 140, 255), cv::FILLED, cv::LINE_AA);
-    }
+    cv::Mat canvas = drawOutlineAndRays(o.side, o.sideMask, o.fit.sideRays);
     for (const auto& [name, p] : o.sideLandmarks) {
         cv::circle(canvas, p, 4, cv::Scalar(0, 255, 0), cv::FILLED, cv::LINE_AA);
         cv::putText(canvas, name, p + cv::Point2d(o.sideNoseImageRight ? 6 : -6 - 7.0 * static_cast<double>(name.size()), 4),
