@@ -1,6 +1,8 @@
 // Fitting the synthetic visitor, whose true shape is known: with ground-truth landmarks the fitted head must be
 // within 1 % of head height (RMS over the head's vertices, after a similarity alignment).
+#include "face/landmarks68.h"
 #include "face/silhouette.h"
+#include "pipeline/fit_pipeline.h"
 #include "head/head_fit.h"
 #include "head/shape_compare.h"
 #include "sim/synthetic_visitor.h"
@@ -65,3 +67,34 @@ TEST_P(SyntheticFit, GroundTruthLandmarksRecoverTheShapeWithinOnePercent) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, SyntheticFit, ::testing::Values(1u, 2u, 3u, 4u));
+
+// The whole automatic pipeline on the synthetic visitor's photos (dlib landmarks, silhouettes, profile
+// landmarks): the fitted head within 3 % of head height of the truth.
+// OPEN (issue 2): measured 3.4 % (seed 1) and 2.9 % (seed 2); dlib's eye corners sit up to 12 px from the feature
+// vertices on the painted face, because the feature vertices come from a design table, not from where dlib finds
+// them on the base head. Disabled until that lands; run it with --gtest_also_run_disabled_tests.
+TEST(SyntheticFitDetected, DISABLED_DetectedLandmarksRecoverTheShapeWithinThreePercent) {
+    const BaseHead& base = builtinBaseHead();
+    const FitPipeline pipeline{FitSettings{}};
+    for (const unsigned seed : {1u, 2u}) {
+        SyntheticVisitorOptions o;
+        o.seed = seed;
+        o.sideNoseImageRight = seed % 2 == 0;
+        const SyntheticVisitor v = makeSyntheticVisitor(base, renderer(), o);
+        for (const bool withPlate : {true, false}) {
+            const FitOutcome out = pipeline.fit(v.front, v.side, withPlate ? v.background : cv::Mat());
+            const double height = headHeight(base, v.truthMesh);
+            const double error = rmsAfterSimilarity(out.fit.mesh, v.truthMesh, headRegion(base));
+            std::printf("seed %u (%s plate): fitted vs truth %.2f mm (%.2f %% of head height)\n", seed,
+                        withPlate ? "with" : "no", error, 100 * error / height);
+            EXPECT_LT(error / height, 0.03) << "seed " << seed;
+            // dlib's points land near the true ones (in pixels of a ~380 px tall head).
+            double worst = 0;
+            for (int k = 36; k <= 47; ++k) {
+                const auto& truth = v.frontLandmarks.at(landmarkName(k));
+                worst = std::max(worst, cv::norm(out.frontLandmarks.points[static_cast<std::size_t>(k)] - truth));
+            }
+            EXPECT_LT(worst, 8.0) << "eye landmarks, seed " << seed;
+        }
+    }
+}
