@@ -24,7 +24,7 @@ struct PhotoMeasurements {
 
 struct HeadFitOptions {
     RbfOptions rbf;
-    // Which front landmarks pull the head (default: all but the inner lips, which follow the mouth's opening).
+    // Which front landmarks pull the head (default: see defaultHeadFitOptions()).
     std::vector<int> frontLandmarks;
     // Accepted ratio between the two photos' scales before they are called a mismatch.
     double maxScaleRatio = 1.35;
