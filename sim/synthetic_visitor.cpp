@@ -3,6 +3,7 @@
 
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/image_io.h"
 #include "export/glb.h"
 #include "face/landmarks68.h"
 #include "head/surface_texels.h"
@@ -245,16 +246,9 @@ SyntheticVisitor makeSyntheticVisitor(const BaseHead& base, MeshRenderer& render
 
 void writeSyntheticVisitorFolder(const SyntheticVisitor& v, const std::filesystem::path& dir) {
     std::filesystem::create_directories(dir / "truth");
-    const auto encode = [](const cv::Mat& image, const char* ext) {
-        std::vector<unsigned char> bytes;
-        std::vector<int> params;
-        if (std::string(ext) == ".jpg") params = {cv::IMWRITE_JPEG_QUALITY, 92};
-        if (!cv::imencode(ext, image, bytes, params)) throw BoothError(ErrorKind::Internal, "", "image encoding failed");
-        return std::string(bytes.begin(), bytes.end());
-    };
-    writeFileAtomically(dir / "front.jpg", encode(v.front, ".jpg"));
-    writeFileAtomically(dir / "side.jpg", encode(v.side, ".jpg"));
-    writeFileAtomically(dir / "background.png", encode(v.background, ".png"));
+    writeFileAtomically(dir / "front.jpg", encodeImage(v.front, ".jpg", 92));
+    writeFileAtomically(dir / "side.jpg", encodeImage(v.side, ".jpg", 92));
+    writeFileAtomically(dir / "background.png", encodeImage(v.background, ".png"));
     writeGlb(dir / "truth" / "head.glb", v.truthMesh, v.texture, "synthetic-visitor");
     nlohmann::json j;
     j["pixel_convention"] = "pixel centres at integer coordinates (OpenCV/dlib)";

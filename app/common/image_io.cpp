@@ -46,6 +46,14 @@ cv::Size jpegSize(const std::vector<unsigned char>& b) {
 
 }  // namespace
 
+std::string encodeImage(const cv::Mat& image, const std::string& ext, int jpegQuality) {
+    std::vector<unsigned char> bytes;
+    std::vector<int> params;
+    if (ext == ".jpg") params = {cv::IMWRITE_JPEG_QUALITY, jpegQuality};
+    if (!cv::imencode(ext, image, bytes, params)) throw BoothError(ErrorKind::Internal, "", "could not encode an image as " + ext);
+    return std::string(bytes.begin(), bytes.end());
+}
+
 cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) {
     std::error_code ec;
     if (!fs::exists(path, ec)) bad(path, "file not found");

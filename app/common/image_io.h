@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 
 #include <filesystem>
+#include <string>
 
 namespace avatarbooth {
 
@@ -12,6 +13,9 @@ struct PhotoLimits {
     long long maxPixels = 40'000'000;
     int minSide = 64;
 };
+
+// Encodes an image as ".jpg" (at the given quality) or ".png" bytes. Throws BoothError(Internal) on failure.
+std::string encodeImage(const cv::Mat& image, const std::string& ext, int jpegQuality = 90);
 
 // Reads a JPEG or PNG (or BMP/PPM) photo as 8-bit BGR. Throws BoothError(BadInput) naming the file and the
 // reason: missing, not a regular file, empty, unknown format, truncated, too large, undecodable.

@@ -14,16 +14,32 @@
 
 namespace avatarbooth {
 
-std::string landmarkName(int k) {
-    char name[16];
-    std::snprintf(name, sizeof name, "ibug_%02d", k);
-    return name;
-}
-
 struct LandmarkDetector::Impl {
     dlib::frontal_face_detector detector = dlib::get_frontal_face_detector();
     dlib::shape_predictor predictor;
+
+    // Face boxes in full-image pixels, largest first.
+    std::vector<cv::Rect> faces(const cv::Mat& fullGrey);
+    // The 68 points inside a face box.
+    std::array<cv::Point2d, 68> landmarks(const cv::Mat& grey, const cv::Rect& face) {
+        const dlib::full_object_detection shape = predictor(
+            dlib::cv_image<unsigned char>(grey), dlib::rectangle(face.x, face.y, face.x + face.width - 1, face.y + face.height - 1));
+        std::array<cv::Point2d, 68> points{};
+        for (unsigned k = 0; k < 68; ++k)
+            points[k] = cv::Point2d(static_cast<double>(shape.part(k).x()), static_cast<double>(shape.part(k).y()));
+        return points;
+    }
 };
+
+namespace {
+
+cv::Mat toGrey(const cv::Mat& bgr) {
+    cv::Mat grey;
+    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+    return grey;
+}
+
+}  // namespace
 
 LandmarkDetector::LandmarkDetector(const std::filesystem::path& model) : impl_(std::make_unique<Impl>()) {
     if (!std::filesystem::is_regular_file(model))
@@ -41,20 +57,19 @@ LandmarkDetector::LandmarkDetector(const std::filesystem::path& model) : impl_(s
 
 LandmarkDetector::~LandmarkDetector() = default;
 
-std::vector<cv::Rect> LandmarkDetector::detectFaces(const cv::Mat& bgr) const {
+std::vector<cv::Rect> LandmarkDetector::Impl::faces(const cv::Mat& fullGrey) {
     // HOG detection costs grow with the pixel count; 640 px keeps a booth face (>= 150 px) well above dlib's
     // 80 px minimum, and small photos are upsampled once so that small faces are still found.
     constexpr int kMaxSide = 640;
-    const double scale = std::min(1.0, static_cast<double>(kMaxSide) / std::max(bgr.cols, bgr.rows));
-    cv::Mat grey;
-    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+    const double scale = std::min(1.0, static_cast<double>(kMaxSide) / std::max(fullGrey.cols, fullGrey.rows));
+    cv::Mat grey = fullGrey;
     if (scale < 1.0) cv::resize(grey, grey, cv::Size(), scale, scale, cv::INTER_AREA);
     double detectScale = scale;
     if (std::max(grey.cols, grey.rows) < 500) {
         cv::resize(grey, grey, cv::Size(), 2.0, 2.0, cv::INTER_LINEAR);
         detectScale *= 2.0;
     }
-    const std::vector<dlib::rectangle> found = impl_->detector(dlib::cv_image<unsigned char>(grey));
+    const std::vector<dlib::rectangle> found = detector(dlib::cv_image<unsigned char>(grey));
     std::vector<cv::Rect> boxes;
     for (const auto& r : found) {
         boxes.emplace_back(cv::Point(static_cast<int>(std::lround(static_cast<double>(r.left()) / detectScale)),
@@ -66,25 +81,20 @@ std::vector<cv::Rect> LandmarkDetector::detectFaces(const cv::Mat& bgr) const {
     return boxes;
 }
 
+std::vector<cv::Rect> LandmarkDetector::detectFaces(const cv::Mat& bgr) const { return impl_->faces(toGrey(bgr)); }
+
 std::array<cv::Point2d, 68> LandmarkDetector::landmarksIn(const cv::Mat& bgr, const cv::Rect& face) const {
-    cv::Mat grey;
-    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-    dlib::cv_image<unsigned char> image(grey);
-    const dlib::full_object_detection shape =
-        impl_->predictor(image, dlib::rectangle(face.x, face.y, face.x + face.width - 1, face.y + face.height - 1));
-    std::array<cv::Point2d, 68> points{};
-    for (unsigned k = 0; k < 68; ++k)
-        points[k] = cv::Point2d(static_cast<double>(shape.part(k).x()), static_cast<double>(shape.part(k).y()));
-    return points;
+    return impl_->landmarks(toGrey(bgr), face);
 }
 
 FaceLandmarks LandmarkDetector::detect(const cv::Mat& bgr) const {
-    const std::vector<cv::Rect> faces = detectFaces(bgr);
+    const cv::Mat grey = toGrey(bgr);  // once, for both the detector and the predictor
+    const std::vector<cv::Rect> faces = impl_->faces(grey);
     if (faces.empty()) throw BoothError(ErrorKind::NoFace, "", "no face found (is the face in view, lit and frontal?)");
     FaceLandmarks result;
     result.face = faces.front();
     result.facesFound = static_cast<int>(faces.size());
-    result.points = landmarksIn(bgr, result.face);
+    result.points = impl_->landmarks(grey, result.face);
     return result;
 }
 

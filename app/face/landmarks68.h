@@ -2,6 +2,8 @@
 // so that dlib's heavy headers stay in one source file.
 #pragma once
 
+#include "common/landmark_names.h"
+
 #include <opencv2/core.hpp>
 
 #include <array>
@@ -17,9 +19,6 @@ struct FaceLandmarks {
     std::array<cv::Point2d, 68> points{};   // iBUG order: jaw 0-16, brows 17-26, nose 27-35, eyes 36-47, mouth 48-67
     int facesFound = 0;                     // how many faces the detector saw (the largest is used)
 };
-
-// Name of landmark k as used for feature vertices ("ibug_07").
-std::string landmarkName(int k);
 
 class LandmarkDetector {
 public:

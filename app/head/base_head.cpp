@@ -2,6 +2,7 @@
 #include "head/base_head.h"
 
 #include "common/error.h"
+#include "common/landmark_names.h"
 #include "export/glb.h"
 #include "head/head_views.h"
 
@@ -22,9 +23,7 @@ glm::dvec3 BaseHead::eyeMidpoint() const {
     glm::dvec3 sum(0.0);
     int count = 0;
     for (int k = 36; k <= 47; ++k) {
-        char name[16];
-        std::snprintf(name, sizeof name, "ibug_%02d", k);
-        if (const auto it = frontFeatures.find(name); it != frontFeatures.end()) {
+        if (const auto it = frontFeatures.find(landmarkName(k)); it != frontFeatures.end()) {
             sum += mesh.positions[it->second];
             ++count;
         }

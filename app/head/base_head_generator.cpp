@@ -18,6 +18,7 @@
 // any tool, export a glb with UVs and write a feature file in the same format by hand; point the config's
 // [head] base_mesh / base_features at them.
 #include "head/base_head.h"
+#include "common/landmark_names.h"
 #include "head/head_views.h"
 
 #include <algorithm>
@@ -201,9 +202,7 @@ BaseHead generate() {
         const glm::dvec3 surface = castFromFront(kLandmarkDesign[k][0], kLandmarkDesign[k][1], View::Front);
         const std::uint32_t v = nearestVertex(mesh, surface, taken);
         taken[v] = true;
-        char name[16];
-        std::snprintf(name, sizeof name, "ibug_%02zu", k);
-        head.frontFeatures[name] = v;
+        head.frontFeatures[landmarkName(static_cast<int>(k))] = v;
     }
     // Mid-sagittal vertices: column kColumns / 2 is longitude 0, i.e. x = 0.
     std::vector<bool> offMidline(mesh.positions.size(), true);

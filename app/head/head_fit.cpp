@@ -2,6 +2,7 @@
 #include "head/head_fit.h"
 
 #include "common/error.h"
+#include "common/landmark_names.h"
 #include "head/head_views.h"
 
 #include <opencv2/core.hpp>
@@ -12,21 +13,15 @@
 namespace avatarbooth {
 namespace {
 
-std::string ibug(int k) {
-    char name[16];
-    std::snprintf(name, sizeof name, "ibug_%02d", k);
-    return name;
-}
-
 cv::Point2d mean(const std::map<std::string, cv::Point2d>& points, int from, int to) {
     cv::Point2d sum(0, 0);
-    for (int k = from; k <= to; ++k) sum += points.at(ibug(k));
+    for (int k = from; k <= to; ++k) sum += points.at(landmarkName(k));
     return sum * (1.0 / (to - from + 1));
 }
 
 glm::dvec3 meanVertex(const Mesh& mesh, const BaseHead& base, int from, int to) {
     glm::dvec3 sum(0.0);
-    for (int k = from; k <= to; ++k) sum += mesh.positions[base.frontFeatures.at(ibug(k))];
+    for (int k = from; k <= to; ++k) sum += mesh.positions[base.frontFeatures.at(landmarkName(k))];
     return sum / static_cast<double>(to - from + 1);
 }
 
@@ -114,7 +109,7 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     HeadFit fit;
     const Mesh& b = base.mesh;
     const auto& fp = photos.frontPoints;
-    for (int k = 0; k < 68; ++k) need(fp, ibug(k), "front");
+    for (int k = 0; k < 68; ++k) need(fp, landmarkName(k), "front");
     if (photos.frontMask.empty() || photos.sideMask.empty())
         throw BoothError(ErrorKind::Internal, "", "fitHead needs both silhouettes");
 
@@ -139,9 +134,9 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     if (mirror) cv::flip(photos.sideMask, sideMask, 1); else sideMask = photos.sideMask;
     const auto side = [&](const std::string& name) { return mirrorPoint(need(photos.sidePoints, name, "side"), sideWidth, mirror); };
     const std::pair<const char*, glm::dvec2> ties[] = {
-        {"top_of_head", frontRel(topPx)},          {"nasion", frontRel(fp.at(ibug(27)))},
-        {"nose_tip", frontRel(fp.at(ibug(30)))},    {"subnasale", frontRel(fp.at(ibug(33)))},
-        {"upper_lip", frontRel(fp.at(ibug(51)))},
+        {"top_of_head", frontRel(topPx)},          {"nasion", frontRel(fp.at(landmarkName(27)))},
+        {"nose_tip", frontRel(fp.at(landmarkName(30)))},    {"subnasale", frontRel(fp.at(landmarkName(33)))},
+        {"upper_lip", frontRel(fp.at(landmarkName(51)))},
     };
     cv::Mat A(5, 2, CV_64F), Y(5, 1, CV_64F);
     for (int i = 0; i < 5; ++i) {
@@ -168,11 +163,11 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
 
     // --- Step 2: per-axis scale of the base head from the measured extents, about the ear-hole centre.
     const auto pos = [&](const std::string& name) { return b.positions[base.sideFeatures.at(name)]; };
-    const glm::dvec3 chinB = b.positions[base.frontFeatures.at(ibug(8))];
-    const double heightPhoto = frontRel(topPx).y - frontRel(fp.at(ibug(8))).y;
+    const glm::dvec3 chinB = b.positions[base.frontFeatures.at(landmarkName(8))];
+    const double heightPhoto = frontRel(topPx).y - frontRel(fp.at(landmarkName(8))).y;
     const double heightBase = pos("top_of_head").y - chinB.y;
-    const double widthPhoto = std::abs(frontRel(fp.at(ibug(16))).x - frontRel(fp.at(ibug(0))).x);
-    const double widthBase = std::abs(b.positions[base.frontFeatures.at(ibug(16))].x - b.positions[base.frontFeatures.at(ibug(0))].x);
+    const double widthPhoto = std::abs(frontRel(fp.at(landmarkName(16))).x - frontRel(fp.at(landmarkName(0))).x);
+    const double widthBase = std::abs(b.positions[base.frontFeatures.at(landmarkName(16))].x - b.positions[base.frontFeatures.at(landmarkName(0))].x);
     const double depthPhoto = (side("nose_tip").x - side("back_of_head").x) * sideMmPerPx;
     const double depthBase = pos("nose_tip").z - pos("back_of_head").z;
     fit.axisScale = glm::dvec3(widthPhoto / widthBase, heightPhoto / heightBase, depthPhoto / depthBase);
@@ -206,7 +201,7 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     const auto addFront = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) { frontT.add(s, name, v, target); };
     const auto addSide = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) { sideT.add(s, name, v, target); };
     for (const int k : options.frontLandmarks) {
-        const std::string name = ibug(k);
+        const std::string name = landmarkName(k);
         addFront(name, base.frontFeatures.at(name), fit.front.toHead(fp.at(name)));
     }
     for (const auto& cv : base.frontContour) {

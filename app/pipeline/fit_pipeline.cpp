@@ -45,14 +45,6 @@ auto stage(FitOutcome& out, const char* name, const fs::path& photo, F&& work) {
     }
 }
 
-std::string encode(const cv::Mat& image, const std::string& ext) {
-    std::vector<unsigned char> bytes;
-    std::vector<int> params;
-    if (ext == ".jpg") params = {cv::IMWRITE_JPEG_QUALITY, 90};
-    if (!cv::imencode(ext, image, bytes, params)) throw BoothError(ErrorKind::Internal, "", "could not encode " + ext);
-    return std::string(bytes.begin(), bytes.end());
-}
-
 std::string readBytes(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -171,18 +163,18 @@ std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& i
     const auto t0 = Clock::now();
     put("avatar.glb", encodeGlb(o.fit.mesh, o.texture.texture, "avatar"));
     // The photos themselves, as taken (personal data: the files are readable by the booth's user only).
-    put("front" + photoExtension(inputs.front), inputs.front.empty() ? encode(o.front, ".jpg") : readBytes(inputs.front));
-    put("side" + photoExtension(inputs.side), inputs.side.empty() ? encode(o.side, ".jpg") : readBytes(inputs.side));
-    put("front_overlay.jpg", encode(drawFrontOverlay(o), ".jpg"));
-    put("side_overlay.jpg", encode(drawSideOverlayWithRays(o), ".jpg"));
+    put("front" + photoExtension(inputs.front), inputs.front.empty() ? encodeImage(o.front, ".jpg") : readBytes(inputs.front));
+    put("side" + photoExtension(inputs.side), inputs.side.empty() ? encodeImage(o.side, ".jpg") : readBytes(inputs.side));
+    put("front_overlay.jpg", encodeImage(drawFrontOverlay(o), ".jpg"));
+    put("side_overlay.jpg", encodeImage(drawSideOverlayWithRays(o), ".jpg"));
     const double exportSeconds = secondsSince(t0);
 
     const auto t1 = Clock::now();
     renderer.upload(o.fit.mesh, o.texture.texture);
     const PreviewSet previews = renderPreviews(renderer, o.fit.mesh, settings_.previewSize);
-    put("preview_front.png", encode(previews.front, ".png"));
-    put("preview_side.png", encode(previews.side, ".png"));
-    put("preview_three_quarter.png", encode(previews.threeQuarter, ".png"));
+    put("preview_front.png", encodeImage(previews.front, ".png"));
+    put("preview_side.png", encodeImage(previews.side, ".png"));
+    put("preview_three_quarter.png", encodeImage(previews.threeQuarter, ".png"));
     const double previewSeconds = secondsSince(t1);
 
     nlohmann::json landmarks;
