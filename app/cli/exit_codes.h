@@ -14,6 +14,7 @@ enum ExitCode : int {
     kExitMismatch = 5,     // the front and side photos do not belong together
     kExitBadConfig = 6,    // the configuration is invalid
     kExitOutput = 7,       // the output could not be written
+    kExitDevice = 8,       // a camera, button line or display is missing, busy or went away
 };
 
 inline int exitCodeFor(ErrorKind kind) {
@@ -23,6 +24,7 @@ inline int exitCodeFor(ErrorKind kind) {
         case ErrorKind::Mismatch: return kExitMismatch;
         case ErrorKind::BadConfig: return kExitBadConfig;
         case ErrorKind::Output: return kExitOutput;
+        case ErrorKind::Device: return kExitDevice;
         case ErrorKind::Internal: return kExitInternal;
     }
     return kExitInternal;

@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
     bool verbose = false;
     app.add_flag("-v,--verbose", verbose, "Log each stage as it runs");
     app.footer("Exit codes: 0 ok, 1 internal error, 2 usage, 3 bad input file, 4 no face found,\n"
-               "            5 photos do not match, 6 bad config, 7 output not writable.");
+               "            5 photos do not match, 6 bad config, 7 output not writable,\n"
+               "            8 device missing or busy (camera, buttons, display).");
     avatarbooth::registerFitCommand(app);
     avatarbooth::registerMakeBaseHeadCommand(app);
     avatarbooth::registerMakeVisitorCommand(app);

@@ -13,6 +13,7 @@ enum class ErrorKind {
     Mismatch,     // the two photos do not belong together (size, view direction)
     BadConfig,    // a configuration file or option has a wrong value
     Output,       // the output could not be written (disk full, permissions)
+    Device,       // a camera, button line or display is missing, busy or went away
     Internal,     // a bug or an unexpected library failure
 };
 
