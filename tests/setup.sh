@@ -10,8 +10,9 @@ packages=(
   build-essential cmake pkg-config git
   libopencv-dev opencv-data libdlib-dev libdlib-data
   libtinygltf-dev nlohmann-json3-dev libglm-dev
-  libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri
+  libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libx11-dev
   libcli11-dev libspdlog-dev libtomlplusplus-dev libsystemd-dev libgpiod-dev libcamera-dev
+  libfreetype-dev fonts-dejavu-core fonts-vlgothic
   libgtest-dev libgmock-dev libbenchmark-dev
   nodejs npm
 )

@@ -1,0 +1,32 @@
+// Opening the booth's buttons and lamps from GpioSettings: GPIO (libgpiod) or the simulation, plus keyboard keys.
+#pragma once
+
+#include "drivers/gpio/buttons.h"
+#include "drivers/gpio/clock.h"
+#include "drivers/gpio/debouncer.h"
+#include "drivers/gpio/gpio_settings.h"
+#include "drivers/gpio/keyboard_buttons.h"
+#include "drivers/gpio/lamps.h"
+
+#include <memory>
+#include <string>
+
+namespace avatarbooth {
+
+struct ButtonBoard {
+    std::unique_ptr<Buttons> buttons;   // the GPIO or scripted buttons merged with the keyboard
+    KeyboardButtons* keyboard = nullptr;  // inside `buttons`: hand the display's key events to keyboard->feed()
+    std::unique_ptr<Lamps> lamps;       // GPIO lamps, or SimLamps (recording) with the sim
+    SimLamps* simLamps = nullptr;       // `lamps` when simulated (to draw them on screen), else null
+    std::string description;            // for the start-up log: which backend and why
+};
+
+// Checks the settings (unique names and offsets, debounce 0-1000 ms, known backend; BoothError BadConfig naming
+// the field) and opens the backend. "auto" takes gpiod when the chip can be opened and the sim otherwise. The sim
+// runs on `clock` from now on (its timeline counts from this call), which must outlive the board.
+ButtonBoard openButtonBoard(const GpioSettings& settings, Clock& clock);
+
+// The debounce settings of one configured button.
+DebounceSettings debounceFor(const GpioSettings& settings, const ButtonSettings& button);
+
+}  // namespace avatarbooth

@@ -1,0 +1,130 @@
+// Lamps: patterns evaluated in time (blink, flash), the driver switching lamps only on change, sim and line lamps.
+#include "drivers/gpio/lamps.h"
+
+#include "common/error.h"
+
+#include <gtest/gtest.h>
+
+namespace avatarbooth {
+namespace {
+
+using namespace std::chrono_literals;
+const SteadyTime T0 = SteadyTime{} + 1h;
+
+TEST(GpioLamps, SteadyAndOff) {
+    EXPECT_TRUE(LampPattern::steady().isOn(T0));
+    EXPECT_FALSE(LampPattern::off().isOn(T0));
+    EXPECT_EQ(LampPattern::steady().nextChange(T0), std::nullopt);
+    EXPECT_EQ(LampPattern::off().nextChange(T0), std::nullopt);
+}
+
+TEST(GpioLamps, BlinkIsOnForTheFirstPartOfEachPeriod) {
+    const auto p = LampPattern::blink(1s, T0 + 10s);
+    EXPECT_FALSE(p.isOn(T0 + 9999ms));
+    EXPECT_TRUE(p.isOn(T0 + 10s));
+    EXPECT_TRUE(p.isOn(T0 + 10499ms));
+    EXPECT_FALSE(p.isOn(T0 + 10500ms));
+    EXPECT_FALSE(p.isOn(T0 + 10999ms));
+    EXPECT_TRUE(p.isOn(T0 + 11s));
+    EXPECT_TRUE(p.isOn(T0 + 1h + 10s + 100ms));
+    EXPECT_EQ(p.nextChange(T0), T0 + 10s);
+    EXPECT_EQ(p.nextChange(T0 + 10200ms), T0 + 10500ms);
+    EXPECT_EQ(p.nextChange(T0 + 10700ms), T0 + 11s);
+    EXPECT_EQ(p.nextChange(T0 + 10500ms), T0 + 11s);
+
+    const auto short_on = LampPattern::blink(400ms, T0, 0.25);
+    EXPECT_TRUE(short_on.isOn(T0 + 99ms));
+    EXPECT_FALSE(short_on.isOn(T0 + 100ms));
+    EXPECT_TRUE(short_on.isOn(T0 + 400ms));
+}
+
+TEST(GpioLamps, FlashIsOnePulse) {
+    const auto p = LampPattern::flash(200ms, T0 + 5s);
+    EXPECT_FALSE(p.isOn(T0 + 4999ms));
+    EXPECT_TRUE(p.isOn(T0 + 5s));
+    EXPECT_TRUE(p.isOn(T0 + 5199ms));
+    EXPECT_FALSE(p.isOn(T0 + 5200ms));
+    EXPECT_FALSE(p.isOn(T0 + 60s));
+    EXPECT_EQ(p.nextChange(T0 + 4s), T0 + 5s);
+    EXPECT_EQ(p.nextChange(T0 + 5100ms), T0 + 5200ms);
+    EXPECT_EQ(p.nextChange(T0 + 6s), std::nullopt);
+}
+
+TEST(GpioLamps, BlinkNeedsAPeriod) {
+    EXPECT_THROW(LampPattern::blink(0ms, T0), BoothError);
+}
+
+TEST(GpioLamps, DriverRecordsExactlyTheChangesOfAttractThenCapture) {
+    ManualClock clock(T0);
+    SimLamps lamps({"start", "retake", "flash"}, clock);
+    LampDriver driver(lamps);
+    // Attract: the start lamp blinks with a 1 s period.
+    driver.setPattern("start", LampPattern::blink(1s, T0));
+    for (auto t = T0; t <= T0 + 2s; t += 250ms) {
+        clock.sleepUntil(t);
+        driver.update(t);
+    }
+    // Capture: start lamp steady, the flash pulses 150 ms.
+    clock.sleepUntil(T0 + 2100ms);
+    driver.setPattern("start", LampPattern::steady());
+    driver.setPattern("flash", LampPattern::flash(150ms, T0 + 2100ms));
+    driver.update(clock.now());
+    EXPECT_EQ(driver.nextChange(clock.now()), T0 + 2250ms);
+    clock.sleepUntil(*driver.nextChange(clock.now()));
+    driver.update(clock.now());
+    EXPECT_EQ(driver.nextChange(clock.now()), std::nullopt);
+
+    using C = SimLamps::Change;
+    EXPECT_EQ(lamps.changes(), (std::vector<C>{{"start", true, T0},
+                                               {"start", false, T0 + 500ms},
+                                               {"start", true, T0 + 1s},
+                                               {"start", false, T0 + 1500ms},
+                                               {"start", true, T0 + 2s},
+                                               {"flash", true, T0 + 2100ms},
+                                               {"flash", false, T0 + 2250ms}}));
+    EXPECT_TRUE(lamps.isOn("start"));
+    EXPECT_FALSE(lamps.isOn("retake"));
+}
+
+TEST(GpioLamps, UnknownLampIsAConfigError) {
+    ManualClock clock(T0);
+    SimLamps lamps({"start"}, clock);
+    LampDriver driver(lamps);
+    try {
+        driver.setPattern("strobe", LampPattern::steady());
+        FAIL() << "no error";
+    } catch (const BoothError& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::BadConfig);
+        EXPECT_STREQ(e.what(), "lamp \"strobe\": no such lamp (lamps: start)");
+    }
+    EXPECT_THROW(lamps.set("strobe", true), BoothError);
+}
+
+// Output lines that remember every level written.
+class RecordingOutputs final : public RawOutputLines {
+public:
+    explicit RecordingOutputs(std::vector<std::pair<std::size_t, bool>>& log) : log_(log) {}
+    void set(std::size_t line, bool high) override { log_.emplace_back(line, high); }
+    std::string describe() const override { return "recording"; }
+
+private:
+    std::vector<std::pair<std::size_t, bool>>& log_;
+};
+
+TEST(GpioLamps, LineLampsDriveActiveLowAndActiveHighLines) {
+    std::vector<std::pair<std::size_t, bool>> log;
+    LineLamps lamps(std::make_unique<RecordingOutputs>(log), {"start", "flash"}, {false, true});
+    // All off at start: the active-low flash relay gets a high line.
+    EXPECT_EQ(log, (std::vector<std::pair<std::size_t, bool>>{{0, false}, {1, true}}));
+    log.clear();
+    lamps.set("start", true);
+    lamps.set("flash", true);
+    lamps.set("flash", false);
+    EXPECT_EQ(log, (std::vector<std::pair<std::size_t, bool>>{{0, true}, {1, false}, {1, true}}));
+    EXPECT_TRUE(lamps.isOn("start"));
+    EXPECT_FALSE(lamps.isOn("flash"));
+    EXPECT_EQ(lamps.names(), (std::vector<std::string>{"start", "flash"}));
+}
+
+}  // namespace
+}  // namespace avatarbooth
