@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include <cmath>
+#include <optional>
 #include <set>
 
 namespace avatarbooth {
@@ -47,6 +48,26 @@ cv::Point2d outlineCrossing(const cv::Mat& mask, const cv::Point2d& start, const
     }
     throw BoothError(ErrorKind::NoFace, "", std::string("the head's outline was not found in the ") + view +
                                                 " photo (the silhouette does not contain the head's centre)");
+}
+
+// Where a half-line from `start` along `dir` first crosses the polyline through `points` (in order), if it does.
+std::optional<cv::Point2d> polylineCrossing(const std::vector<cv::Point2d>& points, const cv::Point2d& start,
+                                            const cv::Point2d& dir) {
+    std::optional<cv::Point2d> best;
+    double bestT = 1e300;
+    for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+        const cv::Point2d a = points[i], e = points[i + 1] - points[i];
+        const double den = dir.x * e.y - dir.y * e.x;
+        if (std::abs(den) < 1e-12) continue;
+        const cv::Point2d w = a - start;
+        const double t = (w.x * e.y - w.y * e.x) / den;  // along the ray
+        const double s = (w.x * dir.y - w.y * dir.x) / den;  // along the segment
+        if (t > 0.0 && s >= 0.0 && s <= 1.0 && t < bestT) {
+            bestT = t;
+            best = start + dir * t;
+        }
+    }
+    return best;
 }
 
 cv::Point2d mirrorPoint(const cv::Point2d& p, int width, bool mirror) {
@@ -168,8 +189,8 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     const double heightBase = pos("top_of_head").y - chinB.y;
     const double widthPhoto = std::abs(frontRel(fp.at(landmarkName(16))).x - frontRel(fp.at(landmarkName(0))).x);
     const double widthBase = std::abs(b.positions[base.frontFeatures.at(landmarkName(16))].x - b.positions[base.frontFeatures.at(landmarkName(0))].x);
-    const double depthPhoto = (side("nose_tip").x - side("back_of_head").x) * sideMmPerPx;
-    const double depthBase = pos("nose_tip").z - pos("back_of_head").z;
+    const double depthPhoto = (side("glabella").x - side("back_of_head").x) * sideMmPerPx;
+    const double depthBase = pos("glabella").z - pos("back_of_head").z;
     fit.axisScale = glm::dvec3(widthPhoto / widthBase, heightPhoto / heightBase, depthPhoto / depthBase);
     for (int c = 0; c < 3; ++c)
         if (!(fit.axisScale[c] > 0.6 && fit.axisScale[c] < 1.6))
@@ -204,10 +225,20 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         const std::string name = landmarkName(k);
         addFront(name, base.frontFeatures.at(name), fit.front.toHead(fp.at(name)));
     }
+    // Below the eye line the silhouette can run on into hair, a collar or the shoulders. dlib's jaw line (points
+    // 0..16, a little inside the true outline: it follows the cheek) says where the face's own outline must be; a
+    // crossing much farther out than it is not the face, and that ray measures nothing.
+    std::vector<cv::Point2d> jawLine;
+    for (int k = 0; k <= 16; ++k) jawLine.push_back(fp.at(landmarkName(k)));
+    constexpr double kOutlineBeyondJaw = 1.4;
     for (const auto& cv : base.frontContour) {
         const glm::dvec3 p = s.positions[cv.vertex];
         const cv::Point2d dir(p.x - eyeMidScaled.x, -(p.y - eyeMidScaled.y));
         const cv::Point2d hit = outlineCrossing(photos.frontMask, eyeMidPx, dir, "front");
+        if (cv.angleDeg > 180.0) {
+            const auto onJaw = polylineCrossing(jawLine, eyeMidPx, dir);
+            if (!onJaw || cv::norm(hit - eyeMidPx) > kOutlineBeyondJaw * cv::norm(*onJaw - eyeMidPx)) continue;
+        }
         fit.frontRays.emplace_back(eyeMidPx, hit);
         addFront("front_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, fit.front.toHead(hit));
     }

@@ -20,7 +20,8 @@ namespace {
 // RMS distance from the points to the nearest scan vertices, after aligning the points onto the scan by
 // iterated closest points with a similarity (scale included: the scan's unit is not stated).
 // Returns the RMS in scan units; *scale receives the total scale from points to scan.
-double icpRms(std::vector<glm::dvec3> points, const std::vector<glm::dvec3>& scan, Similarity initial, double* scale) {
+double icpRms(std::vector<glm::dvec3> points, const std::vector<glm::dvec3>& scan, Similarity initial, double* scale,
+              std::vector<double>* distances = nullptr) {
     cv::Mat data(static_cast<int>(scan.size()), 3, CV_32F);
     for (int i = 0; i < data.rows; ++i)
         for (int c = 0; c < 3; ++c) data.at<float>(i, c) = static_cast<float>(scan[static_cast<std::size_t>(i)][c]);
@@ -40,6 +41,10 @@ double icpRms(std::vector<glm::dvec3> points, const std::vector<glm::dvec3>& sca
             sum += dists.at<float>(i);
         }
         rms = std::sqrt(sum / query.rows);
+        if (distances) {
+            distances->resize(points.size());
+            for (int i = 0; i < query.rows; ++i) (*distances)[static_cast<std::size_t>(i)] = std::sqrt(dists.at<float>(i));
+        }
         const Similarity step = alignSimilarity(points, targets);
         *scale *= step.scale;
         for (auto& p : points) p = step.apply(p);
@@ -49,17 +54,15 @@ double icpRms(std::vector<glm::dvec3> points, const std::vector<glm::dvec3>& sca
 
 }  // namespace
 
-// OPEN (issue 2): measured 2.55 % of head height (6.2 mm RMS), under the 3 % asked, but the unfitted base head
-// measures 2.23 % the same way: the fit does not yet improve on the base head for this scan (the eyes-closed scan's
-// dlib points and profile points pull the warp off). Disabled until it does; run with
-// --gtest_also_run_disabled_tests.
-TEST(ScanFit, DISABLED_FittedHeadIsNearTheScanSurface) {
+// The issue's bar is 3 % of head height; the fit must also come nearer the scan than the unfitted base head (1.65 %
+// measured), or it has learnt nothing from the photos. Measured: 1.59 %.
+TEST(ScanFit, FittedHeadIsNearerTheScanThanTheBaseHead) {
     AVATARBOOTH_REQUIRE_SHARED_DATA();
     const fs::path dir = test::sharedData() / "scan_lee_perry_smith";
     const FitPipeline pipeline{FitSettings{}};
     const FitInputs inputs{dir / "renders" / "LeePerrySmith_yaw+000_rgb.png", dir / "renders" / "LeePerrySmith_yaw+090_rgb.png", {}};
-    const FitOutcome out = pipeline.fit(inputs);
     static MeshRenderer renderer;
+    const FitOutcome out = pipeline.fit(inputs);
     pipeline.write(out, inputs, test::scratchDir("scan_fit") / "session", renderer);
 
     const BaseHead& base = pipeline.baseHead();
@@ -78,8 +81,19 @@ TEST(ScanFit, DISABLED_FittedHeadIsNearTheScanSurface) {
     glm::dvec3 noseScan(0.0, -1e9, -1e9);
     for (const auto& p : scan.positions)
         if (p.z > noseScan.z) noseScan = p;
-    for (const auto& p : scan.positions)
-        if (p.y > noseScan.y - 1500.0) scanHead.push_back(p);  // readGlbMesh gives millimetres of "metres": units x 1000
+    // The scan's surface, sampled densely (every triangle on a barycentric grid, about 1 mm apart) so the
+    // nearest sample is the nearest surface point to within a fraction of a millimetre, not the nearest vertex
+    // (about 5 mm apart, which would put a floor of several millimetres under every distance).
+    constexpr int kSteps = 5;
+    for (const auto& t : scan.triangles) {
+        const glm::dvec3 a = scan.positions[t.x], b = scan.positions[t.y], c = scan.positions[t.z];
+        for (int i = 0; i <= kSteps; ++i)
+            for (int j = 0; i + j <= kSteps; ++j) {
+                const glm::dvec3 p = a + (b - a) * (double(i) / kSteps) + (c - a) * (double(j) / kSteps);
+                // readGlbMesh gives millimetres of "metres": scan units x 1000
+                if (p.y > noseScan.y - 1500.0) scanHead.push_back(p);
+            }
+    }
     // Initial guess: scale by head length, nose tips together.
     Similarity initial;
     const double scanLength = [&] {
@@ -95,7 +109,8 @@ TEST(ScanFit, DISABLED_FittedHeadIsNearTheScanSurface) {
     initial.scale = scanLength / (at("glabella").z - at("back_of_head").z);
     initial.translation = noseScan - initial.scale * at("nose_tip");
     double scale = 1.0;
-    const double rmsScanUnits = icpRms(head, scanHead, initial, &scale);
+    std::vector<double> fittedDistances;
+    const double rmsScanUnits = icpRms(head, scanHead, initial, &scale, &fittedDistances);
     // In the fitted head's millimetres. Distances are to the nearest scan vertex (about 5 mm apart), so they
     // over-state the distance to the surface a little: the test errs on the strict side.
     const double rmsMm = rmsScanUnits / scale;
@@ -113,7 +128,30 @@ TEST(ScanFit, DISABLED_FittedHeadIsNearTheScanSurface) {
     baseInitial.scale = scanLength / (baseAt("glabella").z - baseAt("back_of_head").z);
     baseInitial.translation = noseScan - baseInitial.scale * baseAt("nose_tip");
     double baseScale = 1.0;
-    const double baseRmsMm = icpRms(baseHead, scanHead, baseInitial, &baseScale) / baseScale;
+    std::vector<double> baseDistances;
+    const double baseRmsMm = icpRms(baseHead, scanHead, baseInitial, &baseScale, &baseDistances) / baseScale;
+    // Where the two differ, by region of the head (to see what the fit gets wrong).
+    const auto regionReport = [&](const std::vector<glm::dvec3>& pts, const std::vector<double>& d, double s,
+                                  const char* what) {
+        const char* names[] = {"face", "top", "back", "sides", "lower"};
+        double sums[5] = {}; int counts[5] = {};
+        double zMax = -1e9;
+        for (const auto& p : pts) zMax = std::max(zMax, p.z);
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+            const auto& p = pts[i];
+            int r = 3;
+            if (p.y > 60) r = 1;
+            else if (p.z > zMax - 70 && std::abs(p.x) < 60) r = 0;
+            else if (p.z < -40) r = 2;
+            else if (p.y < -60) r = 4;
+            sums[r] += (d[i] / s) * (d[i] / s); counts[r]++;
+        }
+        std::printf("scan: %s by region:", what);
+        for (int r = 0; r < 5; ++r) std::printf(" %s %.2f mm (%d)", names[r], counts[r] ? std::sqrt(sums[r] / counts[r]) : 0.0, counts[r]);
+        std::printf("\n");
+    };
+    regionReport(head, fittedDistances, scale, "fitted");
+    regionReport(baseHead, baseDistances, baseScale, "base");
     std::printf("scan: the unfitted base head vs scan surface %.2f mm RMS = %.2f %%\n", baseRmsMm, 100.0 * baseRmsMm / headHeight);
     EXPECT_LT(rmsMm, baseRmsMm);
 }

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <map>
 #include <set>
 #include <tuple>
@@ -102,7 +104,8 @@ TEST(BaseHead, ContourVerticesLieOnTheOutline) {
     const glm::dvec2 c = projectToView(head.eyeMidpoint(), View::Front);
     for (const auto& cv : head.frontContour) {
         const glm::dvec2 d = projectToView(head.mesh.positions[cv.vertex], View::Front) - c;
-        EXPECT_NEAR(viewAngleDeg(d), cv.angleDeg, 3.0);
+        // Angles compared on the circle (the jaw rays' 300 degrees is viewAngleDeg's -60).
+        EXPECT_NEAR(std::remainder(viewAngleDeg(d) - cv.angleDeg, 360.0), 0.0, 3.0) << "ray at " << cv.angleDeg;
         // Nothing in the mesh projects further out along this ray (within the same narrow wedge).
         EXPECT_GT(glm::length(d), 60.0);
     }
