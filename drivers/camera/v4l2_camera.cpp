@@ -401,8 +401,12 @@ CameraFrame V4l2Camera::captureStill() {
     const bool samePreviewFormat = stillChoice_.fourcc == previewChoice_.fourcc &&
                                    stillChoice_.width == previewChoice_.width && stillChoice_.height == previewChoice_.height;
     if (samePreviewFormat) {
-        // The preview already is the still format: the next preview frame is the still.
+        // The preview already is the still format: the next preview frame is the still. Frames already waiting
+        // in the queue were exposed before the still was asked for (up to bufferCount frames ago): skip them.
         start();
+        if (wasRunning)
+            while (readFrame(std::chrono::milliseconds(0))) {
+            }
         still = take(wasRunning ? 0 : settings_.stillWarmupFrames);
         if (!wasRunning) stop();
     } else {
