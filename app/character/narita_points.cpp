@@ -235,6 +235,13 @@ NaritaMapping mapNaritaPoints(const NaritaMappingInput& in, const NaritaMappingS
     if (in.earHole) {
         tHole = frame.height(*in.earHole);
         out.earHoleSource = "side photo";
+        // The ear canal lies between the brow line and the nose base (at about 0.45 L): a side photo's estimate
+        // outside that is kept to its ends, so that one bad profile point cannot put the ears on the crown.
+        const double lo = tNoseBase, hi = tBrow;
+        if (tHole < lo || tHole > hi) {
+            out.warnings.push_back("the side photo's ear hole is outside the brow-to-nose-base band: kept to its edge");
+            tHole = std::clamp(tHole, lo, hi);
+        }
     }
     for (std::size_t side = 0; side < 2; ++side) {
         const EarSearch ear = findEarNotches(in.mask, frame, outwards[side], tHole, L, jaws[side], settings);

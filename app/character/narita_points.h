@@ -23,7 +23,8 @@
 //             spans the classical canon instead: top at ear-hole height + 0.45 L, bottom at - 0.55 L, with
 //             L = the height from the brow line (mean of iBUG 17-26) to the nose base (iBUG 33), on the
 //             silhouette's edge at those heights. The ear hole's height comes from the side photo (carried into
-//             the front photo through the fit's shared heights); without one it is brow line - 0.45 L, which puts
+//             the front photo through the fit's shared heights, and kept within the brow-to-nose-base band);
+//             without one it is brow line - 0.45 L, which puts
 //             the canon's ear exactly from the brow line to the nose base (METHODS §5).
 //   Guard: the head's outline is never inside the face. Where the silhouette's edge (for a temple or an ear
 //   point) is missing or lies inside the face's own contour (the jaw landmarks 0-8 / 16-8, extended straight up

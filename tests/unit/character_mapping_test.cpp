@@ -95,6 +95,11 @@ TEST(CharacterMapping, TheSidePhotosEarHoleMovesTheCanonsEar) {
     EXPECT_EQ(m.earHoleSource, "side photo");
     EXPECT_NEAR(m.points.a[0].y, 110.0 - 0.45 * 60.0, 1e-9);
     EXPECT_NEAR(m.points.a[1].y, 110.0 + 0.55 * 60.0, 1e-9);
+    // An ear hole above the brows (a bad profile point) is kept to the brow line (y = 80), with a warning.
+    in.earHole = cv::Point2d(100.0, 40.0);
+    const NaritaMapping high = mapNaritaPoints(in);
+    EXPECT_NEAR(high.points.a[0].y, 80.0 - 0.45 * 60.0, 1e-9);
+    EXPECT_EQ(high.warnings.size(), m.warnings.size() + 1);
 }
 
 TEST(CharacterMapping, FindsTheBaseHeadsEarsOnItsSilhouette) {
