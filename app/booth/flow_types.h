@@ -116,13 +116,13 @@ FlowTime eventTime(const FlowEvent& event);
 
 // ---------------------------------------------------------------------------------------------------- commands
 
-enum class LampPattern { Off, On, SlowBlink, FastBlink };
+enum class LampMode { Off, On, SlowBlink, FastBlink };
 
 // Every lamp's pattern; the flow sends the whole set whenever one changes.
 struct LampState {
-    LampPattern start = LampPattern::Off;
-    LampPattern retake = LampPattern::Off;
-    LampPattern flash = LampPattern::Off;  // the photo flash / fill light
+    LampMode start = LampMode::Off;
+    LampMode retake = LampMode::Off;
+    LampMode flash = LampMode::Off;  // the photo flash / fill light
     bool operator==(const LampState&) const = default;
 };
 

@@ -25,12 +25,12 @@ FlowTime eventTime(const FlowEvent& event) {
 
 std::string describe(const FlowCommand& command) {
     auto photo = [](Photo p) { return p == Photo::Front ? std::string("front") : std::string("side"); };
-    auto lamp = [](LampPattern l) {
+    auto lamp = [](LampMode l) {
         switch (l) {
-            case LampPattern::Off: return "off";
-            case LampPattern::On: return "on";
-            case LampPattern::SlowBlink: return "slow";
-            case LampPattern::FastBlink: return "fast";
+            case LampMode::Off: return "off";
+            case LampMode::On: return "on";
+            case LampMode::SlowBlink: return "slow";
+            case LampMode::FastBlink: return "fast";
         }
         return "?";
     };
@@ -415,14 +415,14 @@ void VisitorFlow::setPreview(bool on, Photo p, std::vector<FlowCommand>& out) {
 void VisitorFlow::updateLamps(std::vector<FlowCommand>& out) {
     LampState l;
     switch (state_) {
-        case State::Attract: l.start = cameraOk_ ? LampPattern::SlowBlink : LampPattern::Off; break;
-        case State::Guide: l.start = LampPattern::On; break;
+        case State::Attract: l.start = cameraOk_ ? LampMode::SlowBlink : LampMode::Off; break;
+        case State::Guide: l.start = LampMode::On; break;
         case State::Countdown: break;
-        case State::Capture: l.flash = LampPattern::On; break;
+        case State::Capture: l.flash = LampMode::On; break;
         case State::Processing: break;
         case State::Reveal:
         case State::RetakeChoice:
-        case State::Operator: l.start = l.retake = LampPattern::On; break;
+        case State::Operator: l.start = l.retake = LampMode::On; break;
         case State::Thanks: break;
         case State::CameraLost: break;
     }
