@@ -136,4 +136,18 @@ std::optional<SteadyTime> LampDriver::nextChange(SteadyTime now) const {
     return best;
 }
 
+bool LampDriver::has(const std::string& name) const {
+    const auto names = lamps_.names();
+    return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+void showAttractLamps(LampDriver& driver, SteadyTime now, std::chrono::nanoseconds period) {
+    for (const auto& name : driver.lampNames())
+        driver.setPattern(name, name == "start" ? LampPattern::blink(period, now) : LampPattern::off());
+}
+
+void flashForCapture(LampDriver& driver, SteadyTime now, std::chrono::nanoseconds pulse) {
+    if (driver.has("flash")) driver.setPattern("flash", LampPattern::flash(pulse, now));
+}
+
 }  // namespace avatarbooth

@@ -101,10 +101,22 @@ public:
     void update(SteadyTime now);
     // The earliest time after `now` at which update() would switch a lamp (to sleep until then).
     std::optional<SteadyTime> nextChange(SteadyTime now) const;
+    // Whether a lamp of that name is configured.
+    bool has(const std::string& name) const;
+    // The configured lamps.
+    std::vector<std::string> lampNames() const { return lamps_.names(); }
 
 private:
     Lamps& lamps_;
     std::map<std::string, LampPattern> patterns_;
 };
+
+// The booth's lamp scenes; lamps a booth does not have are skipped.
+// Attract: the "start" lamp blinks with `period` from `now` (passers-by see which button to press), every other
+// lamp off.
+void showAttractLamps(LampDriver& driver, SteadyTime now, std::chrono::nanoseconds period = std::chrono::seconds(1));
+// Capture: the "flash" lamp gives one pulse of `pulse` from `now`; the other lamps keep their patterns.
+void flashForCapture(LampDriver& driver, SteadyTime now,
+                     std::chrono::nanoseconds pulse = std::chrono::milliseconds(200));
 
 }  // namespace avatarbooth

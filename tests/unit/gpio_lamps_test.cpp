@@ -128,3 +128,44 @@ TEST(GpioLamps, LineLampsDriveActiveLowAndActiveHighLines) {
 
 }  // namespace
 }  // namespace avatarbooth
+
+namespace avatarbooth {
+namespace {
+
+TEST(GpioLamps, AttractThenCaptureScenes) {
+    ManualClock clock(T0);
+    SimLamps lamps({"start", "retake", "flash"}, clock);
+    LampDriver driver(lamps);
+    lamps.set("retake", true);  // left on by an earlier screen
+    showAttractLamps(driver, T0);
+    for (auto t : {T0, T0 + 600ms, T0 + 1s}) {
+        clock.sleepUntil(t);
+        driver.update(t);
+    }
+    flashForCapture(driver, T0 + 1100ms, 100ms);
+    for (auto t : {T0 + 1100ms, T0 + 1200ms}) {
+        clock.sleepUntil(t);
+        driver.update(t);
+    }
+    using C = SimLamps::Change;
+    EXPECT_EQ(lamps.changes(), (std::vector<C>{{"retake", true, T0},
+                                               {"retake", false, T0},
+                                               {"start", true, T0},
+                                               {"start", false, T0 + 600ms},
+                                               {"start", true, T0 + 1s},
+                                               {"flash", true, T0 + 1100ms},
+                                               {"flash", false, T0 + 1200ms}}));
+}
+
+TEST(GpioLamps, ScenesSkipLampsTheBoothDoesNotHave) {
+    ManualClock clock(T0);
+    SimLamps lamps({"start"}, clock);
+    LampDriver driver(lamps);
+    showAttractLamps(driver, T0);
+    flashForCapture(driver, T0);
+    driver.update(T0);
+    EXPECT_EQ(lamps.changes(), (std::vector<SimLamps::Change>{{"start", true, T0}}));
+}
+
+}  // namespace
+}  // namespace avatarbooth
