@@ -128,8 +128,9 @@ SideObservation PreviewAnalyser::observeSide(const cv::Mat& bgr, const cv::Mat& 
     for (const auto& p : largestOutline(mask)) outline.emplace_back(p.x, p.y);
     const ProfileFit right = fitProfile(outline, true), left = fitProfile(outline, false);
     if (right.ok || left.ok) {
-        obs.profileSeen = true;
         obs.noseImageRight = right.ok && (!left.ok || right.noseProminence >= left.noseProminence);
+        obs.noseProminence = (obs.noseImageRight ? right : left).noseProminence;
+        obs.profileSeen = true;
     }
     return obs;
 }

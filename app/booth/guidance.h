@@ -65,6 +65,7 @@ struct SideObservation {
     bool frontalFace = false;    // a frontal face was found on the head
     bool profileSeen = false;    // the head's outline has a nose and a profile's proportions (face/profile.h)
     bool noseImageRight = false; // with profileSeen: which way the nose points in the (unmirrored) frame
+    double noseProminence = 0.0; // of the outline's best nose (ProfileFit::noseProminence), 0 when none
 };
 
 // The side guide's hint: "turn to your right" while a frontal face (or nobody) is seen, "turn more" while turned

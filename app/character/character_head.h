@@ -30,7 +30,7 @@ struct CharacterLook {
 };
 
 struct CharacterSettings {
-    int textureSize = 1024;     // edge of the square painted texture, in texels
+    int textureSize = 512;      // edge of the square painted texture, in texels (flat colours need few)
     double exaggeration = 1.0;  // 1: the given proportions; above 1 pushes each away from the base head's (caricature)
     int correctionRounds = 4;   // measure-and-correct rounds of the deformation
     double pxPerMm = 4.0;       // resolution of the silhouette the head is measured on

@@ -80,6 +80,24 @@ double contourHalfWidth(const std::vector<cv::Point2d>& jaw, const FaceFrame& fr
     return offset(jaw.back());
 }
 
+struct Outline {
+    cv::Point2d point;
+    bool fromSilhouette = true;
+    bool cut = false;
+};
+
+// The head's outline at height t on one side: the silhouette's edge, searched outwards from `start` (on the line
+// at that height), unless it is missing or lies inside the face's own landmark contour (a silhouette that cut
+// into the face): then the contour's point. The head's outline is never inside the face.
+Outline outlineAt(const cv::Mat& mask, const FaceFrame& frame, cv::Point2d start, cv::Point2d out, double t,
+                  const std::vector<cv::Point2d>& jaw, const NaritaMappingSettings& s) {
+    const double contour = contourHalfWidth(jaw, frame, t);
+    const auto edge = edgeAlong(mask, start, out, s.maxReach * frame.eyeDistance, s.gapBridge * frame.eyeDistance);
+    if (edge && dot(edge->point - frame.along(t), out) >= contour - s.contourTolerance * frame.eyeDistance)
+        return {edge->point, true, edge->cut};
+    return {frame.along(t) + contour * out, false, false};
+}
+
 struct EarSearch {
     bool found = false;
     double top = 0.0, bottom = 0.0;  // heights t of the notches
@@ -138,6 +156,9 @@ EarSearch findEarNotches(const cv::Mat& mask, const FaceFrame& frame, cv::Point2
     // from about the ear hole down to the chin) at its height, or it is only the face's own outline.
     const double contour = contourHalfWidth(jaw, frame, ts[peak]);
     if (ws[peak] < contour + s.minEarProtrusion * frame.eyeDistance) return {};
+    // ... and it joins the head at or outside that contour (notches inside the face are the silhouette cutting in).
+    for (const std::size_t notch : {top, bottom})
+        if (ws[notch] < contourHalfWidth(jaw, frame, ts[notch]) - s.contourTolerance * frame.eyeDistance) return {};
     return {true, ts[top], ts[bottom]};
 }
 
@@ -174,21 +195,26 @@ NaritaMapping mapNaritaPoints(const NaritaMappingInput& in, const NaritaMappingS
 
     NaritaMapping out;
     NaritaPoints& P = out.points;
-    const double reach = settings.maxReach * frame.eyeDistance, gap = settings.gapBridge * frame.eyeDistance;
 
     // Temples: the head contour at eye height.
     const std::array<cv::Point2d, 2> eyes = {rightEye, leftEye};
     const std::array<cv::Point2d, 2> outwards = {-frame.u, frame.u};
+    std::array<std::vector<cv::Point2d>, 2> jaws;
+    for (int k = 0; k <= 8; ++k) {
+        jaws[0].push_back(at(k));
+        jaws[1].push_back(at(16 - k));
+    }
+    const char* sideName[2] = {"right", "left"};
     for (std::size_t side = 0; side < 2; ++side) {
-        const auto edge = edgeAlong(in.mask, eyes[side], outwards[side], reach, gap);
-        if (!edge)
-            throw BoothError(ErrorKind::NoFace, "", "character points: the silhouette does not cover the " +
-                                                        std::string(side == 0 ? "right" : "left") + " eye");
-        if (edge->cut)
-            out.warnings.push_back(std::string("the silhouette reaches the ") +
-                                   (edge->distance >= reach ? "search limit" : "frame") + " at eye height on the " +
-                                   (side == 0 ? "right" : "left") + ": that temple is uncertain");
-        P.f[side] = edge->point;
+        const Outline temple = outlineAt(in.mask, frame, eyes[side], outwards[side], 0.0, jaws[side], settings);
+        P.f[side] = temple.point;
+        out.templeSource[side] = temple.fromSilhouette ? "silhouette" : "face contour";
+        if (!temple.fromSilhouette)
+            out.warnings.push_back(std::string("the silhouette does not reach the face's outline at eye height on the ") +
+                                   sideName[side] + ": that temple is on the jaw landmarks' contour");
+        else if (temple.cut)
+            out.warnings.push_back(std::string("the silhouette reaches the frame or the search limit at eye height on the ") +
+                                   sideName[side] + ": that temple is uncertain");
     }
     P.f[2] = at(8);
 
@@ -211,22 +237,23 @@ NaritaMapping mapNaritaPoints(const NaritaMappingInput& in, const NaritaMappingS
         out.earHoleSource = "side photo";
     }
     for (std::size_t side = 0; side < 2; ++side) {
-        std::vector<cv::Point2d> jaw;
-        for (int k = 0; k <= 8; ++k) jaw.push_back(at(side == 0 ? k : 16 - k));
-        const EarSearch ear = findEarNotches(in.mask, frame, outwards[side], tHole, L, jaw, settings);
+        const EarSearch ear = findEarNotches(in.mask, frame, outwards[side], tHole, L, jaws[side], settings);
         const double tTop = ear.found ? ear.top : tHole + 0.45 * L;
         const double tBottom = ear.found ? ear.bottom : tHole - 0.55 * L;
         out.earSource[side] = ear.found ? "silhouette" : "canon";
-        const auto top = edgeAlong(in.mask, frame.along(tTop), outwards[side], reach, gap);
-        const auto bottom = edgeAlong(in.mask, frame.along(tBottom), outwards[side], reach, gap);
-        if (!top || !bottom)
-            throw BoothError(ErrorKind::NoFace, "", std::string("character points: no silhouette at the ") +
-                                                        (side == 0 ? "right" : "left") + " ear's height");
-        P.a[2 * side] = top->point;
-        P.a[2 * side + 1] = bottom->point;
+        const Outline top = outlineAt(in.mask, frame, frame.along(tTop), outwards[side], tTop, jaws[side], settings);
+        const Outline bottom =
+            outlineAt(in.mask, frame, frame.along(tBottom), outwards[side], tBottom, jaws[side], settings);
+        P.a[2 * side] = top.point;
+        P.a[2 * side + 1] = bottom.point;
+        out.earPointSource[2 * side] = top.fromSilhouette ? "silhouette" : "face contour";
+        out.earPointSource[2 * side + 1] = bottom.fromSilhouette ? "silhouette" : "face contour";
         if (!ear.found)
-            out.warnings.push_back(std::string("the ") + (side == 0 ? "right" : "left") +
+            out.warnings.push_back(std::string("the ") + sideName[side] +
                                    " ear was not found on the silhouette (hidden by hair?): estimated from the canon");
+        if (!top.fromSilhouette || !bottom.fromSilhouette)
+            out.warnings.push_back(std::string("the silhouette does not reach the face's outline at the ") +
+                                   sideName[side] + " ear's height: put on the jaw landmarks' contour");
     }
     return out;
 }

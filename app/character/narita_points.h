@@ -25,6 +25,10 @@
 //             silhouette's edge at those heights. The ear hole's height comes from the side photo (carried into
 //             the front photo through the fit's shared heights); without one it is brow line - 0.45 L, which puts
 //             the canon's ear exactly from the brow line to the nose base (METHODS §5).
+//   Guard: the head's outline is never inside the face. Where the silhouette's edge (for a temple or an ear
+//   point) is missing or lies inside the face's own contour (the jaw landmarks 0-8 / 16-8, extended straight up
+//   from iBUG 0 / 16 above it), the silhouette cut into the face; the point is put on that contour instead, with
+//   a warning. So a bad silhouette never fails the session, it only makes those points estimates.
 //   Extra (not among the 21, for the tilts the thesis found missing): the brows' outer ends, iBUG 17 and 26.
 #pragma once
 
@@ -56,6 +60,7 @@ struct NaritaMappingSettings {
     double gapBridge = 0.06;    // background runs shorter than this (a gap between lobe and jaw) are bridged
     double minNotchDepth = 0.035;  // an ear's notches must be at least this deep below the hull (about 2 mm)
     double minEarProtrusion = 0.08;  // and the ear must reach this far beyond the jaw contour (about 5 mm)
+    double contourTolerance = 0.03;  // a silhouette edge this far inside the jaw contour still counts as on it
 };
 
 struct NaritaMappingInput {
@@ -68,12 +73,16 @@ struct NaritaMapping {
     NaritaPoints points;
     // Per ear (right, left): "silhouette" (notches found) or "canon" (estimated from the ear hole and L).
     std::array<std::string, 2> earSource;
+    // Per temple (right, left) and per ear point (Pa0..Pa3): "silhouette" (on its edge), or "face contour" where
+    // the silhouette fell short (see the guard above).
+    std::array<std::string, 2> templeSource;
+    std::array<std::string, 4> earPointSource;
     std::string earHoleSource;  // "side photo" or "canon"
     std::vector<std::string> warnings;
 };
 
-// Throws BoothError(NoFace) when the eyes coincide, the mask is empty or does not cover the eyes, or the brows
-// are not above the nose base; BoothError(BadInput) when the mask's size is not usable.
+// Throws BoothError(NoFace) when the eyes coincide or the brows are not above the nose base; BoothError(BadInput)
+// when there is no 8-bit mask.
 NaritaMapping mapNaritaPoints(const NaritaMappingInput& input, const NaritaMappingSettings& settings = {});
 
 // Draws the 21 points (and the extras) with their names on a BGR canvas.

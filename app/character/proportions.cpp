@@ -34,17 +34,20 @@ double tiltDeg(const cv::Point2d& inner, const cv::Point2d& outer, const cv::Poi
 
 // Slider ranges. The middle of each is about what the built-in base head (an average adult face) measures with
 // this mapping (r0 1.29, r1 0.50, r2 0.144, r3 0.120, r4 0.342, r5 0.133, r6 0.221, r7 0.378, eye spacing 0.359,
-// eye tilt -0.6 deg, brow tilt -3.7 deg); the half-widths cover what real faces measure (the faces68 photos:
-// r0 0.89-1.71 as hair widens the silhouette or not, r2 0.08-0.16, eye spacing 0.21-0.48, brow tilt down to -28
-// deg) with room for stylised characters. Temples are on the silhouette (ears or hair included), so l_f0 is wider
-// than the face across the cheekbones and the ratios are correspondingly smaller than on a drawn character.
+// eye tilt -0.6 deg, brow tilt -3.7 deg); the half-widths cover what real faces measure with room for stylised
+// characters. Measured on the 8 FRMDB people fitted in the booth's way (../shared/data/frmdb): r0 0.89-1.44,
+// r1 0.34-0.61, r2 0.11-0.16, r3 0.01-0.13, r4 0.31-0.43, r5 0.06-0.12, r6 0.18-0.26, r7 0.31-0.44; on the
+// faces68 photos r0 up to 1.71 and brow tilts down to -28 deg. Temples are on the silhouette (ears or hair
+// included), so l_f0 is wider than the face across the cheekbones and the ratios are correspondingly smaller than
+// on a drawn character; and r1, by the seed's formula, mostly shows how asymmetric the silhouette is at eye height
+// (a parting, hair over one side), hence its wide range.
 constexpr std::array<SliderRange, 11> kSliders = {{
     {"face_aspect", "r0", 0.8, 1.8, "face height / face width (2 x chin to face line / temple to temple)"},
-    {"eye_position", "r1", 0.4, 0.6, "where the pair of eyes sits between the temples (0.5: centred)"},
+    {"eye_position", "r1", 0.25, 0.75, "where the pair of eyes sits between the temples (0.5: centred)"},
     {"eye_size", "r2", 0.06, 0.22, "eye width along the face line / face width"},
     {"ear_position", "r3", 0.0, 0.25, "ear top's distance from the face line / face width"},
     {"ear_size", "r4", 0.15, 0.55, "ear height across the face line / face width"},
-    {"brow_position", "r5", 0.05, 0.21, "brow inner ends' distance from the face line / face width"},
+    {"brow_position", "r5", 0.02, 0.2, "brow inner ends' distance from the face line / face width"},
     {"nose_position", "r6", 0.1, 0.34, "nose tip's distance from the face line / face width"},
     {"mouth_position", "r7", 0.22, 0.54, "mouth centre's distance from the face line / face width"},
     {"eye_spacing", "eye_spacing", 0.2, 0.52, "distance between the eye centres along the face line / face width"},
@@ -127,7 +130,9 @@ nlohmann::json characterJson(const NaritaMapping& mapping, const CharacterPropor
     j["pixel_convention"] = "front photo pixels, pixel centres at integer coordinates";
     for (const auto& [name, q] : mapping.points.named()) j["points"][name] = {q.x, q.y};
     j["point_sources"] = {
-        {"Pf0, Pf1", "temples: the silhouette's edge on the eye line, outwards from each eye centre"},
+        {"Pf0, Pf1", "temples on the eye line: right " + mapping.templeSource[0] + ", left " + mapping.templeSource[1] +
+                         " (silhouette: its edge outwards from the eye centre; face contour: the jaw landmarks' contour "
+                         "where the silhouette fell short)"},
         {"Pf2", "ibug_08"},
         {"Pe0..Pe4", "ibug_36, ibug_39, mid(ibug_37, ibug_38), ibug_41, ibug_40"},
         {"Pe5..Pe9", "ibug_45, ibug_42, mid(ibug_43, ibug_44), ibug_46, ibug_47"},
@@ -135,8 +140,10 @@ nlohmann::json characterJson(const NaritaMapping& mapping, const CharacterPropor
         {"Pn", "ibug_30"},
         {"Pm", "mid(ibug_62, ibug_66)"},
         {"brow_outer_right, brow_outer_left", "ibug_17, ibug_26"},
-        {"Pa0, Pa1", "right ear top and bottom: " + mapping.earSource[0]},
-        {"Pa2, Pa3", "left ear top and bottom: " + mapping.earSource[1]},
+        {"Pa0, Pa1", "right ear top and bottom: " + mapping.earSource[0] + " (points on the " +
+                         mapping.earPointSource[0] + ", " + mapping.earPointSource[1] + ")"},
+        {"Pa2, Pa3", "left ear top and bottom: " + mapping.earSource[1] + " (points on the " +
+                         mapping.earPointSource[2] + ", " + mapping.earPointSource[3] + ")"},
         {"ear_hole", mapping.earHoleSource}};
     j["lengths_px"] = {{"l_f0", p.lf0}, {"l_f1", p.lf1}};
     for (std::size_t i = 0; i < p.r.size(); ++i) j["ratios"]["r" + std::to_string(i)] = p.r[i];

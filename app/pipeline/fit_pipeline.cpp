@@ -1,6 +1,7 @@
 // The photo-to-head pipeline: stages, timings, error attribution, the session folder.
 #include "pipeline/fit_pipeline.h"
 
+#include "character/character_outputs.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/image_io.h"
@@ -199,6 +200,14 @@ std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& i
     }
     put("landmarks.json", landmarks.dump(2) + "\n");
 
+    // Character maker (issue 6, app/character/): Narita's proportions and the stylised character head.
+    const auto tCharacter = Clock::now();
+    const CharacterOutputs character = makeCharacterOutputs(o.front, o.frontLandmarks.points, o.frontMask,
+                                                            earHoleInFrontPhoto(o.fit, o.sideLandmarks), base_);
+    put("character.json", character.json);
+    put("character.glb", character.glb);
+    const double characterSeconds = secondsSince(tCharacter);
+
     nlohmann::json report;
     report["version"] = AVATARBOOTH_VERSION;
     report["inputs"] = {{"front", inputs.front.string()}, {"side", inputs.side.string()},
@@ -217,6 +226,7 @@ std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& i
     }
     stages.push_back({{"stage", "export"}, {"seconds", exportSeconds}});
     stages.push_back({{"stage", "previews"}, {"seconds", previewSeconds}});
+    stages.push_back({{"stage", "character"}, {"seconds", characterSeconds}});
     report["stages"] = stages;
     report["fit_seconds"] = total;
     nlohmann::json residuals = nlohmann::json::array();
@@ -231,6 +241,7 @@ std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& i
     report["residual_rms_mm"] = o.fit.residuals.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(o.fit.residuals.size()));
     report["residual_max_mm"] = worst;
     report["warnings"] = o.warnings;
+    for (const auto& w : character.warnings) report["warnings"].push_back("character: " + w);
     // fit.json last: its presence marks a complete result.
     put("fit.json", report.dump(2) + "\n");
     dir.commit();

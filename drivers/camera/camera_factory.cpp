@@ -12,8 +12,10 @@ namespace avatarbooth {
 
 namespace {
 
+// A node the v4l2 backend can stream from on its own: a capture node with a format we read, not one end of a
+// media-controller pipeline (those are libcamera's).
 bool usableV4l2(const V4l2DeviceInfo& info) {
-    return info.canCapture && negotiateV4l2Format(info.formats, 0, 0, 0).has_value();
+    return info.canCapture && !info.mediaControllerCentric && negotiateV4l2Format(info.formats, 0, 0, 0).has_value();
 }
 
 // Adds the reason for the choice to the description; everything else goes straight through.
@@ -142,7 +144,8 @@ std::vector<CameraListEntry> listCameras() {
         else if (!info.canCapture)
             e.formats = "not a single-planar video capture node";
         else
-            e.formats = describeV4l2Formats(info.formats);
+            e.formats = (info.mediaControllerCentric ? "media-controller node (use libcamera): " : "") +
+                        describeV4l2Formats(info.formats);
         e.usable = usableV4l2(info);
         list.push_back(std::move(e));
     }

@@ -315,7 +315,8 @@ std::optional<CameraFrame> LibcameraCamera::nextFrame(std::chrono::milliseconds 
     start();
     auto frame = d.read(timeout);
     if (frame) {
-        frame->sequence += d.sequenceBase;
+        // Some drivers repeat a sequence number when they fall behind (vivid under load does): keep ours rising.
+        frame->sequence = std::max(frame->sequence + d.sequenceBase, d.nextSequence);
         d.nextSequence = frame->sequence + 1;
     }
     return frame;

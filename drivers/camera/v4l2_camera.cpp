@@ -148,6 +148,7 @@ V4l2DeviceInfo probeV4l2Device(const std::string& path) {
         info.bus = text(cap.bus_info, sizeof cap.bus_info);
         const auto caps = nodeCaps(cap);
         info.canCapture = (caps & V4L2_CAP_VIDEO_CAPTURE) && (caps & V4L2_CAP_STREAMING);
+        info.mediaControllerCentric = (caps & V4L2_CAP_IO_MC) != 0;
         if (info.canCapture) info.formats = queryFormats(fd);
     }
     ::close(fd);
@@ -158,7 +159,7 @@ V4l2Camera::V4l2Camera(const CameraSettings& settings) : settings_(settings), de
     if (device_.empty()) {
         for (const auto& node : listV4l2Nodes()) {
             const auto info = probeV4l2Device(node);
-            if (info.canCapture && negotiateV4l2Format(info.formats, 0, 0, 0)) {
+            if (info.canCapture && !info.mediaControllerCentric && negotiateV4l2Format(info.formats, 0, 0, 0)) {
                 device_ = node;
                 break;
             }
@@ -194,6 +195,9 @@ V4l2Camera::V4l2Camera(const CameraSettings& settings) : settings_(settings), de
         }
         if (!(caps & V4L2_CAP_STREAMING))
             throw BoothError(ErrorKind::Device, device_, "cannot stream (no V4L2_CAP_STREAMING)");
+        if (caps & V4L2_CAP_IO_MC)
+            spdlog::warn("camera {}: a media-controller pipeline node; it may not stream unless the pipeline is set "
+                         "up (the libcamera backend does that)", device_);
 
         formats_ = queryFormats(fd_);
         const auto preview = negotiateV4l2Format(formats_, settings_.previewWidth, settings_.previewHeight, settings_.previewFps);
@@ -339,20 +343,20 @@ std::optional<CameraFrame> V4l2Camera::readFrame(std::chrono::milliseconds timeo
                          {std::span(static_cast<const std::uint8_t*>(mapped.start), used)}};
             image = rawFrameToBgr(raw);
         }
-        if (xioctl(fd_, VIDIOC_QBUF, &buf) != 0) fail("VIDIOC_QBUF", errno);
-        if (image.empty()) {
-            ++dropped_;
-            spdlog::debug("camera {}: dropped broken frame {}", device_, buf.sequence);
-            continue;
-        }
-
         CameraFrame frame;
-        frame.image = std::move(image);
         frame.sequence = buf.sequence;
         if ((buf.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC)
             frame.timestamp = std::chrono::seconds(buf.timestamp.tv_sec) + std::chrono::microseconds(buf.timestamp.tv_usec);
         else
             frame.timestamp = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch());
+        // QBUF writes the buffer's new (queued) state back into `buf`: read the frame's fields before it.
+        if (xioctl(fd_, VIDIOC_QBUF, &buf) != 0) fail("VIDIOC_QBUF", errno);
+        if (image.empty()) {
+            ++dropped_;
+            spdlog::debug("camera {}: dropped broken frame {}", device_, frame.sequence);
+            continue;
+        }
+        frame.image = std::move(image);
         return frame;
     }
 }
@@ -372,7 +376,8 @@ std::optional<CameraFrame> V4l2Camera::nextFrame(std::chrono::milliseconds timeo
     start();
     auto frame = readFrame(timeout);
     if (frame) {
-        frame->sequence += sequenceBase_;
+        // Some drivers repeat a sequence number when they fall behind (vivid under load does): keep ours rising.
+        frame->sequence = std::max(frame->sequence + sequenceBase_, nextSequence_);
         nextSequence_ = frame->sequence + 1;
     }
     return frame;
@@ -396,8 +401,12 @@ CameraFrame V4l2Camera::captureStill() {
     const bool samePreviewFormat = stillChoice_.fourcc == previewChoice_.fourcc &&
                                    stillChoice_.width == previewChoice_.width && stillChoice_.height == previewChoice_.height;
     if (samePreviewFormat) {
-        // The preview already is the still format: the next preview frame is the still.
+        // The preview already is the still format: the next preview frame is the still. Frames already waiting
+        // in the queue were exposed before the still was asked for (up to bufferCount frames ago): skip them.
         start();
+        if (wasRunning)
+            while (readFrame(std::chrono::milliseconds(0))) {
+            }
         still = take(wasRunning ? 0 : settings_.stillWarmupFrames);
         if (!wasRunning) stop();
     } else {

@@ -20,6 +20,9 @@ struct V4l2DeviceInfo {
     std::string driver;  // e.g. "uvcvideo", "vivid"
     std::string bus;     // e.g. "usb-0000:01:00.0-1.3"
     bool canCapture = false;  // single-planar video capture with streaming (what this backend drives)
+    // The node is one end of a media-controller pipeline (V4L2_CAP_IO_MC: a Pi's unicam, vimc, ISPs); it streams
+    // only once the pipeline is configured, which libcamera does: "auto" leaves such nodes to libcamera.
+    bool mediaControllerCentric = false;
     std::vector<V4l2Format> formats;
     std::string error;   // why it could not be opened or queried; empty when it could
 };

@@ -1,10 +1,9 @@
-// The guides on real images: the synthetic visitor's and frmdb's front photos say "hold still", their profiles are
-// seen as profiles (and the fronts are not), and the preview analyses run at 10 Hz or more (figures printed).
+// The guides on rendered images: the synthetic visitor's front photo says "hold still", its profiles (either way)
+// are seen as profiles and its front is not, the empty booth has nobody, and the preview analyses' rates are
+// printed (the real photos' test is tests/data/booth_guidance_data_test.cpp).
 #include "booth/guidance.h"
-#include "common/image_io.h"
 #include "face/landmarks68.h"
 #include "sim/synthetic_visitor.h"
-#include "test_paths.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -13,8 +12,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 
 using namespace avatarbooth;
 
@@ -45,24 +42,6 @@ cv::Mat preview(const cv::Mat& photo) {
     const double s = 640.0 / photo.cols;
     cv::resize(photo, out, {}, s, s, cv::INTER_AREA);
     return out;
-}
-
-struct FrmdbRow {
-    std::string id, front, profileLeft, profileRight, threeQuarterLeft, threeQuarterRight;
-};
-
-std::vector<FrmdbRow> frmdbRows() {
-    std::ifstream in(test::sharedData() / "frmdb" / "pairs.csv");
-    std::vector<FrmdbRow> rows;
-    std::string line;
-    std::getline(in, line);  // header: person_id,sex,age,front,profile_nose_left,profile_nose_right,...
-    while (std::getline(in, line)) {
-        std::vector<std::string> cells;
-        std::stringstream ss(line);
-        for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
-        if (cells.size() >= 8) rows.push_back({cells[0], cells[3], cells[4], cells[5], cells[6], cells[7]});
-    }
-    return rows;
 }
 
 double medianMs(std::vector<double> v) {
@@ -109,48 +88,6 @@ TEST(GuidanceImages, EmptyBoothHasNobody) {
     const SideObservation side = analyser.observeSide(empty);
     EXPECT_FALSE(side.profileSeen);
     EXPECT_EQ(sideHint(side), Hint::TurnRight);
-}
-
-TEST(GuidanceImages, FrmdbFrontsSayHoldStillAndProfilesAreSeen) {
-    AVATARBOOTH_REQUIRE_SHARED_DATA();
-    PreviewAnalyser analyser(&detector(), {});
-    const auto dir = test::sharedData() / "frmdb";
-    for (const FrmdbRow& row : frmdbRows()) {
-        const cv::Mat front = preview(readPhoto(dir / row.front));
-        const FrontObservation obs = analyser.observeFront(front);
-        ASSERT_TRUE(obs.face.has_value()) << row.front;
-        const cv::Rect2d oval = ovalBox(GuidanceSettings{}.oval, obs.frame);
-        const auto& p = *obs.landmarks;
-        const double eyes = cv::norm(p[45] - p[36]);
-        std::printf("frmdb %s front: face/oval %.2f, centre off (%.2f, %.2f) oval heights, yaw %.2f\n",
-                    row.id.c_str(), obs.face->height / oval.height,
-                    (obs.face->x + obs.face->width / 2 - oval.x - oval.width / 2) / oval.height,
-                    (obs.face->y + obs.face->height / 2 - oval.y - oval.height / 2) / oval.height,
-                    (p[30].x - 0.5 * (p[36].x + p[45].x)) / eyes);
-        EXPECT_EQ(frontHint(obs, {}), Hint::HoldStill) << row.front;
-        const SideObservation asSide = analyser.observeSide(front);
-        EXPECT_NE(sideHint(asSide), Hint::HoldStill) << row.front << " taken for a profile";
-        for (const auto& file : {row.threeQuarterLeft, row.threeQuarterRight}) {
-            const FrontObservation turned = analyser.observeFront(preview(readPhoto(dir / file)));
-            const Hint hint = frontHint(turned, {});
-            double yaw = 0.0;
-            if (turned.landmarks) {
-                const auto& q = *turned.landmarks;
-                yaw = (q[30].x - 0.5 * (q[36].x + q[45].x)) / cv::norm(q[45] - q[36]);
-            }
-            std::printf("frmdb %s (45 degrees): front hint %s, yaw %.2f\n", file.c_str(), toString(hint), yaw);
-            EXPECT_TRUE(hint == Hint::NoFace || hint == Hint::LookAtCamera) << file;
-        }
-        for (const auto& [file, noseRight] : {std::pair{row.profileLeft, false}, std::pair{row.profileRight, true}}) {
-            const SideObservation side = analyser.observeSide(preview(readPhoto(dir / file)));
-            std::printf("frmdb %s: person %d frontal %d profile %d noseRight %d\n", file.c_str(), side.personSeen,
-                        side.frontalFace, side.profileSeen, side.noseImageRight);
-            EXPECT_EQ(sideHint(side), Hint::HoldStill) << file;
-            if (side.profileSeen) {
-                EXPECT_EQ(side.noseImageRight, noseRight) << file;
-            }
-        }
-    }
 }
 
 TEST(GuidanceImages, PreviewAnalysisRateIsPrinted) {

@@ -598,6 +598,19 @@ TEST(VisitorFlow, CameraLostOnTheRevealStillKeeps) {
     EXPECT_EQ(b.model().banner, BannerKind::CameraLost);
     EXPECT_EQ(b.press(Button::Start), (Names{kLampsOff, "SaveSession"}));
     EXPECT_EQ(b.screen(), ScreenId::Thanks);
+    EXPECT_EQ(b.back(), Names{});
+    EXPECT_EQ(b.model().banner, BannerKind::None);
+}
+
+TEST(VisitorFlow, CameraLostAndBackOnTheRevealChangesNothingElse) {
+    Booth b;
+    b.toReveal();
+    b.lost();
+    EXPECT_EQ(b.back(), Names{});
+    EXPECT_EQ(b.screen(), ScreenId::Reveal);
+    EXPECT_EQ(b.model().banner, BannerKind::None);
+    EXPECT_EQ(b.press(Button::Retake), Names{});  // same lamps on the retake question
+    EXPECT_EQ(b.screen(), ScreenId::RetakeChoice);
 }
 
 TEST(VisitorFlow, CameraLostOnTheRetakeChoiceWaitsForTheCameraThenRetakes) {
@@ -622,6 +635,14 @@ TEST(VisitorFlow, CameraLostOnThanksKeepsTheCodeAndBlocksANewSession) {
     b.after(20.0);
     EXPECT_EQ(b.screen(), ScreenId::Attract);
     EXPECT_EQ(b.model().banner, BannerKind::CameraLost);
+}
+
+TEST(VisitorFlow, CameraBackOnThanksAllowsTheNextSession) {
+    Booth b;
+    b.toThanks();
+    b.lost();
+    EXPECT_EQ(b.back(), Names{});
+    EXPECT_EQ(b.press(Button::Start, 6.0), (Names{kLampsGuide, "StartPreview(front)"}));
 }
 
 TEST(VisitorFlow, CameraLostTooLongEndsTheSession) {

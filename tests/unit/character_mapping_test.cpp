@@ -154,13 +154,41 @@ TEST(CharacterMapping, RefusesMasksThatCannotBeUsed) {
     in.mask = cv::Mat();
     EXPECT_THROW(mapNaritaPoints(in), BoothError);
     in = boxFace();
-    in.mask.setTo(0);
+    for (int k = 36; k < 48; ++k) in.landmarks[static_cast<std::size_t>(k)] = in.landmarks[45];
     try {
         mapNaritaPoints(in);
-        FAIL() << "an empty silhouette was accepted";
+        FAIL() << "coinciding eyes were accepted";
     } catch (const BoothError& e) {
         EXPECT_EQ(e.kind(), ErrorKind::NoFace);
     }
+}
+
+// A silhouette that misses the face (here: none at all) does not fail: the temples and ears go on the face's own
+// contour (the jaw landmarks; above iBUG 0 / 16, straight up from them), with warnings.
+TEST(CharacterMapping, ASilhouetteInsideTheFaceFallsBackToTheJawContour) {
+    NaritaMappingInput in = boxFace();
+    in.mask.setTo(0);
+    const NaritaMapping m = mapNaritaPoints(in);
+    EXPECT_EQ(m.templeSource[0], "face contour");
+    EXPECT_EQ(m.templeSource[1], "face contour");
+    EXPECT_NEAR(m.points.f[0].x, 30.0, 1e-9);  // iBUG 0 is at (30, 100), on the eye line
+    EXPECT_NEAR(m.points.f[1].x, 170.0, 1e-9);
+    EXPECT_NEAR(m.points.a[0].x, 30.0, 1e-9);  // the ear top (y = 80) is above iBUG 0: straight up from it
+    EXPECT_NEAR(m.points.a[0].y, 80.0, 1e-9);
+    // The bottom (y = 140) is on the jaw polyline, between iBUG 2 and 3.
+    const auto jaw = [](double k) {
+        const double a = 3.14159265358979323846 * k / 16.0;
+        return cv::Point2d(100.0 - 70.0 * std::cos(a), 100.0 + 100.0 * std::sin(a));
+    };
+    const double f = (140.0 - jaw(2).y) / (jaw(3).y - jaw(2).y);
+    EXPECT_NEAR(m.points.a[1].x, jaw(2).x + f * (jaw(3).x - jaw(2).x), 1e-9);
+    EXPECT_NEAR(m.points.a[1].y, 140.0, 1e-9);
+    EXPECT_EQ(m.warnings.size(), 6u);  // 2 temples, 2 ears estimated, 2 ears on the contour
+    // The same happens to a silhouette that cuts into the face: a head box narrower than the jaw.
+    in = boxFace();
+    in.mask.setTo(0);
+    in.mask(cv::Rect(50, 10, 101, 280)).setTo(255);
+    EXPECT_EQ(mapNaritaPoints(in).templeSource[0], "face contour");
 }
 
 }  // namespace

@@ -163,6 +163,7 @@ TEST(CharacterProportions, JsonHoldsPointsRatiosAndSliders) {
     NaritaMapping mapping;
     mapping.points = handMade();
     mapping.earSource = {"silhouette", "canon"};
+    mapping.earPointSource = {"silhouette", "silhouette", "silhouette", "face contour"};
     mapping.earHoleSource = "side photo";
     mapping.warnings = {"the left ear was not found"};
     const nlohmann::json j = characterJson(mapping, computeProportions(mapping.points));
@@ -175,7 +176,7 @@ TEST(CharacterProportions, JsonHoldsPointsRatiosAndSliders) {
     EXPECT_DOUBLE_EQ(j["sliders"]["face_aspect"]["value"].get<double>(), 0.4);
     EXPECT_EQ(j["sliders"]["face_aspect"]["range"], nlohmann::json({0.8, 1.8}));
     EXPECT_EQ(j["sliders"].size(), 11u);
-    EXPECT_EQ(j["point_sources"]["Pa2, Pa3"], "left ear top and bottom: canon");
+    EXPECT_EQ(j["point_sources"]["Pa2, Pa3"], "left ear top and bottom: canon (points on the silhouette, face contour)");
     EXPECT_EQ(j["warnings"].size(), 1u);
 }
 
