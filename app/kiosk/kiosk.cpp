@@ -291,10 +291,10 @@ public:
         wake_.notify_all();
         thread_.join();
     }
+    // The analyser is rebuilt with it by the worker thread, between two analyses (never under a running one).
     void setDetector(const LandmarkDetector* detector) {
         std::lock_guard lock(mutex_);
         detector_ = detector;
-        analyser_.reset();  // rebuilt with the detector
     }
     // Offers a frame; ignored while the previous one is still being analysed.
     void offer(Photo photo, const cv::Mat& frame, FlowTime t) {
@@ -340,7 +340,10 @@ private:
                 pending_.reset();
                 busy_ = true;
                 detector = detector_;
-                if (!analyser_) analyser_ = std::make_unique<PreviewAnalyser>(detector, PreviewAnalyser::Options{});
+            }
+            if (!analyser_ || detector != analyserDetector_) {
+                analyser_ = std::make_unique<PreviewAnalyser>(detector, PreviewAnalyser::Options{});
+                analyserDetector_ = detector;
             }
             std::optional<PreviewAnalysed> result;
             const auto t0 = std::chrono::steady_clock::now();
@@ -364,7 +367,8 @@ private:
     mutable std::mutex mutex_;
     std::condition_variable wake_, idle_;
     const LandmarkDetector* detector_ = nullptr;
-    std::unique_ptr<PreviewAnalyser> analyser_;
+    std::unique_ptr<PreviewAnalyser> analyser_;      // used by the worker thread only
+    const LandmarkDetector* analyserDetector_ = nullptr;
     std::optional<Pending> pending_;
     std::optional<PreviewAnalysed> result_;
     bool busy_ = false;
@@ -474,6 +478,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             [&](const auto& c) {
                 using T = std::decay_t<decltype(c)>;
                 if constexpr (std::is_same_v<T, StartPreview>) {
+                    if (previewFor != c.photo) lastPreview.release();  // never show the other pose's last frame
                     previewFor = c.photo;
                     try {
                         camera->start();
@@ -555,7 +560,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
 
         // Buttons, keyboard, and the simulated visitor.
         if (board.keyboard)
-            for (const auto& key : display.pollKeys()) board.keyboard->feed(key.name, key.pressed, clock.now());
+            for (const auto& key : display.pollKeys()) board.keyboard->feed(key.key, key.pressed, key.time);
         while (auto e = board.buttons->poll(std::chrono::milliseconds(0))) {
             if (const auto b = buttonNamed(e->button)) {
                 if (e->action == ButtonAction::Press) events.push_back(ButtonPressed{*b, now});
@@ -683,7 +688,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             screenshotDue = !options.screenshots.empty();
         }
         // A screen's picture once it has what it shows: the preview on guides, the avatar on the reveal.
-        const bool complete = (!previewScreen || !inputs.preview.empty()) &&
+        const bool complete = (!previewScreen || (!inputs.preview.empty() && screen.sinceEntered >= Millis(700))) &&
                               (screen.id != ScreenId::Reveal || !inputs.avatar.empty()) &&
                               (screen.id != ScreenId::Thanks || !screen.code.empty());
         if (screenshotDue && complete) {

@@ -152,11 +152,11 @@ TEST(Config, MistakesNameFileLineAndKey) {
     EXPECT_EQ(errorOf("[flow]\nlock_combo = \"start+coin\"\n"),
               "booth.toml:2: flow.lock_combo: \"coin\" is not a button (start, retake, service; joined by +)");
     EXPECT_EQ(errorOf("[[buttons.button]]\nname = \"start\"\noffset = 4\n[[buttons.lamp]]\nname = \"flash\"\noffset = 4\n"),
-              "booth.toml:1: buttons.lamp: line 4 is used twice");
+              "booth.toml:4: buttons.lamp: line 4 is used twice");
     EXPECT_EQ(errorOf("[[buttons.button]]\nname = \"start\"\npin = 4\n"),
               "booth.toml:3: buttons.button[0].pin: unknown key (see the reference booth.toml for the keys there are)");
     EXPECT_EQ(errorOf("[fit]\nbase_mesh = \"head.glb\"\n"),
-              "booth.toml:1: fit.base_features: give both base_mesh and base_features, or neither");
+              "booth.toml:2: fit.base_mesh: give both base_mesh and base_features, or neither");
     EXPECT_EQ(errorOf("[sessions]\nphoto_retention_hours = 48\nsession_retention_days = 1\n"),
               "booth.toml:3: sessions.session_retention_days: sessions would be deleted before their photos' retention ends");
     // Not TOML at all: the parser's own message, with the line.
