@@ -11,6 +11,8 @@ void registerFitCommand(CLI::App& app);
 void registerMakeBaseHeadCommand(CLI::App& app);
 // `avatarbooth make-visitor`: writes a synthetic visitor's session folder (photos with known ground truth).
 void registerMakeVisitorCommand(CLI::App& app);
+// `avatarbooth run`: the kiosk (real devices when present, else the simulated booth).
+void registerRunCommand(CLI::App& app);
 // `avatarbooth bench`: per-stage fit times on one photo pair.
 void registerBenchCommand(CLI::App& app);
 

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
     app.footer("Exit codes: 0 ok, 1 internal error, 2 usage, 3 bad input file, 4 no face found,\n"
                "            5 photos do not match, 6 bad config, 7 output not writable,\n"
                "            8 device missing or busy (camera, buttons, display).");
+    avatarbooth::registerRunCommand(app);
     avatarbooth::registerFitCommand(app);
     avatarbooth::registerMakeBaseHeadCommand(app);
     avatarbooth::registerMakeVisitorCommand(app);

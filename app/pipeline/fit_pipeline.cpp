@@ -27,7 +27,8 @@ double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 
 // Runs one stage, timing it, and names the photo in any error that does not name a file yet.
 template <typename F>
-auto stage(FitOutcome& out, const char* name, const fs::path& photo, F&& work) {
+auto stage(FitOutcome& out, const StageListener& listener, const char* name, const fs::path& photo, F&& work) {
+    if (listener) listener(name);
     const auto t0 = Clock::now();
     try {
         if constexpr (std::is_void_v<decltype(work())>) {
@@ -83,7 +84,7 @@ FitOutcome FitPipeline::fit(const FitInputs& inputs) const {
 }
 
 FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv::Mat& background,
-                            const FitInputs& names) const {
+                            const FitInputs& names, const StageListener& listener) const {
     FitOutcome out;
     out.front = front;
     out.side = side;
@@ -91,13 +92,13 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     if (!background.empty() && background.size() != side.size())
         throw BoothError(ErrorKind::BadInput, names.side.string(), "the side photo and the background plate differ in size");
 
-    out.frontLandmarks = stage(out, "front_landmarks", names.front, [&] { return detector_->detect(front); });
+    out.frontLandmarks = stage(out, listener, "front_landmarks", names.front, [&] { return detector_->detect(front); });
     if (out.frontLandmarks.facesFound > 1)
         out.warnings.push_back(std::to_string(out.frontLandmarks.facesFound) +
                                " faces in the front photo; the largest was used");
-    out.frontMask = stage(out, "front_silhouette", names.front,
+    out.frontMask = stage(out, listener, "front_silhouette", names.front,
                           [&] { return segmentPerson(front, background, out.frontLandmarks.face); });
-    const SideAnalysis sideAnalysis = stage(out, "side_profile", names.side, [&] { return analyzeSidePhoto(side, background); });
+    const SideAnalysis sideAnalysis = stage(out, listener, "side_profile", names.side, [&] { return analyzeSidePhoto(side, background); });
     out.sideMask = sideAnalysis.mask;
     out.sideNoseImageRight = sideAnalysis.noseImageRight;
     for (const auto& p : sideAnalysis.landmarks) out.sideLandmarks[p.name] = p.px;
@@ -109,9 +110,9 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     m.sidePoints = out.sideLandmarks;
     m.sideMask = out.sideMask;
     m.sideNoseImageRight = out.sideNoseImageRight;
-    out.fit = stage(out, "head_fit", names.side, [&] { return fitHead(base_, m, settings_.head); });
+    out.fit = stage(out, listener, "head_fit", names.side, [&] { return fitHead(base_, m, settings_.head); });
     for (const auto& w : out.fit.warnings) out.warnings.push_back(w);
-    out.texture = stage(out, "texture", fs::path(), [&] {
+    out.texture = stage(out, listener, "texture", fs::path(), [&] {
         return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture);
     });
     return out;

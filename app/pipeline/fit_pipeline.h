@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -44,6 +45,10 @@ struct FitOutcome {
     std::vector<std::string> warnings;
 };
 
+// Told the name of each stage as it starts ("front_landmarks", "front_silhouette", "side_profile", "head_fit",
+// "texture"), from the fitting thread: the kiosk shows progress with it.
+using StageListener = std::function<void(const std::string& stage)>;
+
 class FitPipeline {
 public:
     // Loads the landmark model (1-2 s): build one pipeline and reuse it.
@@ -52,12 +57,14 @@ public:
 
     double modelLoadSeconds() const { return modelLoadSeconds_; }
     const BaseHead& baseHead() const { return base_; }
+    // The loaded landmark detector, for the kiosk's preview guidance (not while a fit runs: one user at a time).
+    const LandmarkDetector& detector() const { return *detector_; }
 
     // Reads, analyses, fits and textures. Errors are BoothErrors naming the photo they concern.
     FitOutcome fit(const FitInputs& inputs) const;
     // The same on photos already in memory (names are used in error messages).
     FitOutcome fit(const cv::Mat& front, const cv::Mat& side, const cv::Mat& background,
-                   const FitInputs& names = {}) const;
+                   const FitInputs& names = {}, const StageListener& listener = {}) const;
 
     // Writes the session folder atomically: it is complete, or absent (an earlier result stays as it was).
     // Returns the paths of what was written. The renderer makes the previews.

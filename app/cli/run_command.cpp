@@ -1,0 +1,128 @@
+// `avatarbooth run [--config booth.toml] [--sessions N] [--screenshots DIR]`: the kiosk.
+#include "cli/commands.h"
+
+#include "common/error.h"
+#include "config/booth_config.h"
+#include "drivers/camera/camera_factory.h"
+#include "kiosk/kiosk.h"
+#include "render/mesh_renderer.h"
+#include "sim/sim_visitor.h"
+#include "sim/synthetic_visitor.h"
+
+#include <spdlog/spdlog.h>
+
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdlib>
+#include <iostream>
+
+namespace avatarbooth {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::atomic<bool> stopRequested{false};
+extern "C" void onStopSignal(int) { stopRequested.store(true); }
+
+constexpr const char* kInstalledConfig = "/etc/avatarbooth/booth.toml";
+
+// Whether this process may create and write the folder (or its nearest existing parent).
+bool writable(fs::path dir) {
+    while (!dir.empty() && !fs::exists(dir)) dir = dir.parent_path();
+    return !dir.empty() && ::access(dir.c_str(), W_OK | X_OK) == 0;
+}
+
+// A developer's own data folder, for runs without a config on a machine where /var/lib is the system's.
+fs::path userDataDir() {
+    if (const char* s = std::getenv("XDG_STATE_HOME"); s && *s) return fs::path(s) / "avatarbooth";
+    if (const char* h = std::getenv("HOME"); h && *h) return fs::path(h) / ".local/state/avatarbooth";
+    return fs::temp_directory_path() / "avatarbooth";
+}
+
+}  // namespace
+
+void registerRunCommand(CLI::App& app) {
+    auto* cmd = app.add_subcommand("run", "Run the booth: camera, buttons, screen and the visitor flow (the kiosk)");
+    struct Options {
+        std::string config;
+        int sessions = 0;
+        std::string screenshots;
+        std::string visitor = "auto";
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("--config", o->config,
+                    std::string("Configuration file (default: ") + kInstalledConfig + " when it exists, else built-in defaults)");
+    cmd->add_option("--sessions", o->sessions, "Stop after this many visitor sessions (default: run until stopped)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--screenshots", o->screenshots, "Write a PNG of every screen shown into this folder");
+    cmd->add_option("--visitor", o->visitor,
+                    "Simulated visitor at a simulated booth: auto (when camera and buttons are both simulated), "
+                    "yes, no")
+        ->check(CLI::IsMember({"auto", "yes", "no"}))
+        ->capture_default_str();
+    cmd->callback([o] {
+        spdlog::set_level(spdlog::get_level() > spdlog::level::info ? spdlog::level::info : spdlog::get_level());
+        BoothConfig config;
+        if (!o->config.empty()) config = loadBoothConfig(o->config);
+        else if (fs::exists(kInstalledConfig)) config = loadBoothConfig(kInstalledConfig);
+        const bool configured = !config.file.empty();
+
+        // Real devices when present, the simulated booth otherwise; "auto" resolves here so the choice is said once.
+        const bool simCamera = config.camera.backend == "sim" ||
+                               (config.camera.backend == "auto" && listCameras().empty());
+        if (simCamera && config.camera.backend == "auto") {
+            std::cerr << "avatarbooth: no camera found: running the simulated booth\n";
+            config.camera.backend = "sim";
+        }
+        if (!configured && !writable(config.sessions.directory)) {
+            const fs::path fallback = userDataDir() / "sessions";
+            std::cerr << "avatarbooth: " << config.sessions.directory.string() << " is not writable for this user; "
+                      << "sessions go to " << fallback.string() << "\n";
+            config.sessions.directory = fallback;
+        }
+        if (config.camera.backend == "sim" && config.camera.simFolder.empty()) {
+            // The simulated camera shows the synthetic visitor: a head of known shape with its photos.
+            const fs::path dir = config.sessions.directory.parent_path() / "synthetic-visitor";
+            if (!fs::exists(dir / "front.png")) {
+                MeshRenderer renderer;
+                const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, SyntheticVisitorOptions{});
+                fs::create_directories(dir);
+                writeSyntheticVisitorFolder(visitor, dir);
+            }
+            config.camera.simFolder = dir.string();
+            std::cerr << "avatarbooth: the simulated camera shows the synthetic visitor in " << dir.string() << "\n";
+        }
+        const bool simButtons = config.buttons.backend == "sim" ||
+                                (config.buttons.backend == "auto" && !fs::exists("/dev/" + config.buttons.chip) &&
+                                 !fs::exists(config.buttons.chip));
+        const bool visitor = o->visitor == "yes" ||
+                             (o->visitor == "auto" && config.camera.backend == "sim" && simButtons &&
+                              config.buttons.timeline.empty());
+        SimVisitor simVisitor;
+        if (visitor) std::cerr << "avatarbooth: a simulated visitor uses the booth\n";
+
+        std::signal(SIGINT, onStopSignal);
+        std::signal(SIGTERM, onStopSignal);
+        KioskOptions options;
+        options.sessions = o->sessions;
+        options.screenshots = o->screenshots;
+        options.visitor = visitor ? &simVisitor : nullptr;
+        options.stop = &stopRequested;
+        const KioskReport report = runKiosk(config, options);
+
+        std::cout << report.sessionsEnded << " visitor session(s); kept:";
+        for (const auto& code : report.keptCodes) std::cout << " " << code;
+        if (report.keptCodes.empty()) std::cout << " none";
+        std::cout << "\n";
+        for (const auto& code : report.keptCodes)
+            std::cout << "session " << code << ": " << (report.sessionsDirectory / code).string()
+                      << " (avatar.glb, previews, photos)\n";
+        if (!report.screenshots.empty())
+            std::cout << report.screenshots.size() << " screenshots in " << o->screenshots << "\n";
+        std::cout << "start-up to ready: " << static_cast<int>(report.startupToReadySeconds * 1000.0) << " ms\n";
+    });
+}
+
+}  // namespace avatarbooth

@@ -1,0 +1,56 @@
+// The booth's configuration file (TOML): one table per part, each filling that part's settings struct.
+//
+// Every key has a default (the struct's own), so an empty file is a valid configuration. The file is read
+// strictly: an unknown table or key, a value of the wrong type or out of range is an error naming the file, the
+// line and the key (ErrorKind::BadConfig), so a typo never silently falls back to a default. The reference of every
+// key, with its default, is the shipped app/assets/booth.toml (installed as /etc/avatarbooth/booth.toml).
+#pragma once
+
+#include "animation/avatar_motion.h"
+#include "booth/guidance.h"
+#include "booth/session_store.h"
+#include "booth/visitor_flow.h"
+#include "drivers/camera/camera_settings.h"
+#include "drivers/display/display_settings.h"
+#include "drivers/gpio/gpio_settings.h"
+#include "head/base_head.h"
+#include "pipeline/fit_pipeline.h"
+#include "screens/screens.h"
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+namespace avatarbooth {
+
+// [fit]: the photo-to-head pipeline. The base head is the built-in one unless both files are given.
+struct FitConfig {
+    FitSettings settings;
+    std::filesystem::path baseMesh;      // your own base head (glb with UVs), see `avatarbooth make-base-head`
+    std::filesystem::path baseFeatures;  // its feature file
+};
+
+struct BoothConfig {
+    std::filesystem::path file;  // where it was read from; empty for the built-in defaults
+    FitConfig fit;               // [fit]
+    CameraSettings camera;       // [camera]
+    GpioSettings buttons;        // [buttons]
+    DisplaySettings display;     // [display]
+    ScreenSettings screen;       // [screen]
+    BoothSettings flow;          // [flow]
+    GuidanceSettings guidance;   // [guidance]
+    SessionStoreSettings sessions;  // [sessions]
+    AnimationSettings animation;    // [animation]
+};
+
+// Reads and checks a configuration file. Throws BoothError(BadConfig) with "FILE:LINE: key: what is wrong", or
+// BoothError(BadInput) when the file cannot be read.
+BoothConfig loadBoothConfig(const std::filesystem::path& file);
+
+// The same from text (`name` stands for the file in messages).
+BoothConfig parseBoothConfig(const std::string& text, const std::string& name);
+
+// The base head the configuration asks for: the built-in one, or the operator's own (loaded once per call).
+std::shared_ptr<const BaseHead> configuredBaseHead(const FitConfig& fit);
+
+}  // namespace avatarbooth

@@ -1,0 +1,53 @@
+// The kiosk daemon: wires the camera, buttons, lamps and display to the visitor flow, the screens, the fit and the
+// session store, and runs the main loop (`avatarbooth run`).
+//
+// One thread runs the loop (events in, flow, commands out, one screen per frame); the landmark model loads, the
+// preview is analysed and the fit runs on worker threads, so the screen never stops. The flow itself
+// (booth/visitor_flow.h) is plain logic; everything here is the plumbing around it.
+#pragma once
+
+#include "booth/flow_types.h"
+#include "config/booth_config.h"
+#include "drivers/camera/sim_camera.h"
+
+#include <atomic>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace avatarbooth {
+
+// Someone standing at the simulated booth: told what the screen shows, it says what the simulated camera sees and
+// which button it presses. Implemented by sim/sim_visitor.h; the kiosk only knows this interface.
+class VisitorScript {
+public:
+    struct Action {
+        SimScene scene = SimScene::Empty;
+        std::optional<Button> press;  // pressed now and released a moment later
+    };
+    virtual ~VisitorScript() = default;
+    virtual Action step(const ScreenModel& screen, FlowTime now) = 0;
+};
+
+struct KioskOptions {
+    int sessions = 0;                         // stop after this many visitor sessions have ended (0: run until stopped)
+    std::filesystem::path screenshots;        // write a PNG of every screen shown into this folder (empty: none)
+    VisitorScript* visitor = nullptr;         // a simulated visitor drives the sim camera's scene and presses
+    const std::atomic<bool>* stop = nullptr;  // set (by a signal handler) to stop cleanly
+};
+
+struct KioskReport {
+    int sessionsEnded = 0;                        // visitors who came and went (kept, discarded or walked away)
+    std::vector<std::string> keptCodes;           // the codes of the sessions kept, in order
+    std::vector<std::filesystem::path> screenshots;  // written, in order
+    std::filesystem::path sessionsDirectory;
+    std::vector<std::string> devices;             // what was opened, one line each (as logged at start-up)
+    double startupToReadySeconds = 0.0;           // to the attract screen and READY=1
+};
+
+// Runs the booth until options.sessions have ended or options.stop is set. Throws BoothError when a device or the
+// configuration cannot be used at start-up (a camera lost later is waited for, not fatal).
+KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options);
+
+}  // namespace avatarbooth

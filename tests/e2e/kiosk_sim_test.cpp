@@ -1,0 +1,93 @@
+// The simulated booth end to end: `avatarbooth run` with the sim camera, sim buttons, a headless display and the
+// simulated visitor runs one whole session, keeps it under a code, and writes a screenshot of every screen.
+#include "test_paths.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <fstream>
+#include <regex>
+
+namespace fs = std::filesystem;
+using namespace avatarbooth::test;
+
+namespace {
+
+struct CommandResult {
+    int exitCode = -1;
+    std::string output;
+};
+
+CommandResult run(const std::string& args) {
+    CommandResult r;
+    const std::string cmd = binary().string() + " " + args + " 2>&1";
+    FILE* pipe = popen(cmd.c_str(), "r");
+    std::array<char, 4096> buf{};
+    while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
+    const int status = pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+// Share of the pixels in the middle of the picture that are skin or hair coloured (red over blue), where the
+// booth's background is a dark blue.
+double headPixelsInMiddle(const cv::Mat& bgr) {
+    const cv::Rect middle(bgr.cols / 3, bgr.rows / 5, bgr.cols / 3, bgr.rows * 3 / 5);
+    int count = 0;
+    for (int y = middle.y; y < middle.br().y; ++y)
+        for (int x = middle.x; x < middle.br().x; ++x) {
+            const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
+            if (p[2] > p[0] + 25 && p[2] > 60) ++count;
+        }
+    return static_cast<double>(count) / middle.area();
+}
+
+}  // namespace
+
+TEST(KioskSim, OneScriptedSessionEndToEnd) {
+    const fs::path dir = scratchDir("kiosk_sim");
+    const fs::path config = dir / "booth.toml";
+    std::ofstream(config) << "[camera]\nbackend = \"sim\"\n[buttons]\nbackend = \"sim\"\n[display]\nbackend = \"headless\"\n"
+                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
+    const CommandResult r = run("run --config " + config.string() + " --sessions 1 --screenshots " + (dir / "screens").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+
+    // Kept under the code the thanks screen showed, complete, readable only by the booth's user.
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(r.output, m, std::regex("kept: ([2-9A-Z]{6})"))) << r.output;
+    const fs::path session = dir / "sessions" / m[1].str();
+    for (const char* f : {"avatar.glb", "fit.json", "landmarks.json", "front.jpg", "side.jpg", "preview_front.png"})
+        EXPECT_TRUE(fs::is_regular_file(session / f)) << f;
+    EXPECT_EQ(fs::status(session).permissions() & (fs::perms::group_all | fs::perms::others_all), fs::perms::none);
+    EXPECT_FALSE(fs::exists(dir / "sessions" / ".pending") && !fs::is_empty(dir / "sessions" / ".pending"))
+        << "a pending fit was left behind";
+
+    // A screenshot of every screen of the session, in the order shown.
+    std::vector<std::string> shown;
+    for (const auto& e : fs::directory_iterator(dir / "screens")) shown.push_back(e.path().filename().string());
+    std::sort(shown.begin(), shown.end());
+    const std::vector<std::string> expected = {"00_attract.png",  "01_front_guide.png",   "02_countdown.png",
+                                               "03_capture_flash.png", "04_side_guide.png", "05_countdown.png",
+                                               "06_capture_flash.png", "07_processing.png", "08_reveal.png",
+                                               "09_thanks.png",   "10_attract.png"};
+    EXPECT_EQ(shown, expected) << r.output;
+
+    // The reveal shows the avatar: a head's worth of skin and hair in the middle of the screen; the processing
+    // screen (same background, no avatar) does not.
+    const cv::Mat reveal = cv::imread((dir / "screens" / "08_reveal.png").string());
+    const cv::Mat processing = cv::imread((dir / "screens" / "07_processing.png").string());
+    ASSERT_FALSE(reveal.empty());
+    ASSERT_FALSE(processing.empty());
+    EXPECT_GT(headPixelsInMiddle(reveal), 0.10);
+    EXPECT_LT(headPixelsInMiddle(processing), 0.03);  // its title and spinner are orange
+    // The side guide shows the visitor in profile: the mirrored preview differs from the front guide's.
+    const cv::Mat front = cv::imread((dir / "screens" / "01_front_guide.png").string());
+    const cv::Mat side = cv::imread((dir / "screens" / "04_side_guide.png").string());
+    ASSERT_FALSE(front.empty());
+    ASSERT_FALSE(side.empty());
+    EXPECT_GT(cv::norm(front, side, cv::NORM_L1) / static_cast<double>(front.total()), 10.0);
+}
