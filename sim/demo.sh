@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The README's main command: set up (packages, build), then run the main job on the embedded default — until the
-# kiosk lands, that is `fit` on the bundled synthetic visitor — and say where the avatar and previews are.
+# The README's main command: set up (packages, build), then run the kiosk on the simulated booth for one whole
+# visitor session (headless), and say where the screenshots of every screen and the avatar are.
 # Usage: sim/demo.sh [OUTPUT_FOLDER]   (default: ./out/demo)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -8,5 +8,10 @@ out="${1:-$root/out/demo}"
 "$root/tests/setup.sh" release
 bin="$root/build/release/app/avatarbooth"
 mkdir -p "$out"
-"$bin" make-visitor --seed 1 -o "$out/visitor"
-"$bin" fit --front "$out/visitor/front.jpg" --side "$out/visitor/side.jpg" -o "$out/session"
+out="$(cd "$out" && pwd)"
+# The demo's config: the simulated booth, with the sessions kept in the output folder.
+config="$out/booth.toml"
+{ cat "$root/sim/demo.toml"; printf '\n[sessions]\ndirectory = "%s"\n' "$out/sessions"; } > "$config"
+rm -rf "$out/screens"
+"$bin" run --config "$config" --sessions 1 --screenshots "$out/screens"
+echo "demo: screenshots of every screen in $out/screens; the visitor's session (avatar.glb, previews) in $out/sessions"

@@ -2,6 +2,7 @@
 #include "cli/commands.h"
 
 #include "common/error.h"
+#include "config/booth_config.h"
 #include "pipeline/fit_pipeline.h"
 
 #include <iostream>
@@ -18,6 +19,7 @@ void registerFitCommand(CLI::App& app) {
         std::string model = AVATARBOOTH_DEFAULT_DLIB_MODEL;
         std::string baseMesh, baseFeatures;
         int textureSize = 1024;
+        std::string config;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("--front", o->inputs.front, "Front photo (JPEG or PNG)")->required();
@@ -31,17 +33,30 @@ void registerFitCommand(CLI::App& app) {
     cmd->add_option("--base-mesh", o->baseMesh, "Your own base head (glb with UVs) instead of the built-in one");
     cmd->add_option("--base-features", o->baseFeatures, "Feature file of --base-mesh (see make-base-head)");
     cmd->add_option("--texture-size", o->textureSize, "Texture size in texels")->capture_default_str()->check(CLI::Range(256, 4096));
-    cmd->callback([o] {
-        FitSettings settings;
-        try {
-            settings.head.rbf.kernel = parseRbfKernel(o->kernel);
-        } catch (const std::invalid_argument& e) {
-            throw BoothError(ErrorKind::BadConfig, "--kernel", e.what());
+    cmd->add_option("--config", o->config, "Booth configuration: its [fit] table gives the defaults of the options above");
+    cmd->callback([o, cmd] {
+        // The config's [fit] table first; each option given on the command line then wins over it.
+        FitConfig fromFile;
+        if (!o->config.empty()) fromFile = loadBoothConfig(o->config).fit;
+        FitSettings settings = fromFile.settings;
+        const auto given = [&](const char* option) { return cmd->count(option) > 0; };
+        if (given("--kernel")) {
+            try {
+                settings.head.rbf.kernel = parseRbfKernel(o->kernel);
+            } catch (const std::invalid_argument& e) {
+                throw BoothError(ErrorKind::BadConfig, "--kernel", e.what());
+            }
         }
-        if (!(o->unitMm > 0.0)) throw BoothError(ErrorKind::BadConfig, "--rbf-unit-mm", "must be positive");
-        settings.head.rbf.unitMm = o->unitMm;
-        settings.landmarkModel = o->model;
-        settings.texture.size = o->textureSize;
+        if (given("--rbf-unit-mm")) {
+            if (!(o->unitMm > 0.0)) throw BoothError(ErrorKind::BadConfig, "--rbf-unit-mm", "must be positive");
+            settings.head.rbf.unitMm = o->unitMm;
+        }
+        if (given("--landmark-model") || o->config.empty()) settings.landmarkModel = o->model;
+        if (given("--texture-size") || o->config.empty()) settings.texture.size = o->textureSize;
+        if (!given("--base-mesh") && !given("--base-features")) {
+            o->baseMesh = fromFile.baseMesh.string();
+            o->baseFeatures = fromFile.baseFeatures.string();
+        }
         if (o->baseMesh.empty() != o->baseFeatures.empty())
             throw BoothError(ErrorKind::BadConfig, "--base-mesh/--base-features", "give both or neither");
         std::unique_ptr<BaseHead> custom;

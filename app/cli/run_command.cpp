@@ -15,6 +15,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 
@@ -121,7 +122,12 @@ void registerRunCommand(CLI::App& app) {
                       << " (avatar.glb, previews, photos)\n";
         if (!report.screenshots.empty())
             std::cout << report.screenshots.size() << " screenshots in " << o->screenshots << "\n";
-        std::cout << "start-up to ready: " << static_cast<int>(report.startupToReadySeconds * 1000.0) << " ms\n";
+        std::printf("figures: start-up to ready %.0f ms; guides %.1f frames/s with %.1f face-guidance analyses/s; "
+                    "side photo to avatar on screen %.2f s; reveal frame %.1f ms (%.0f fps possible); peak RSS %.0f MB\n",
+                    report.startupToReadySeconds * 1000.0, report.guideFramesPerSecond, report.analysesPerSecond,
+                    report.sideCaptureToRevealSeconds, report.revealFrameMilliseconds,
+                    report.revealFrameMilliseconds > 0.0 ? 1000.0 / report.revealFrameMilliseconds : 0.0,
+                    report.peakRssMegabytes);
     });
 }
 

@@ -69,8 +69,15 @@ RbfWarp::RbfWarp(std::vector<glm::dvec3> centres, const std::vector<std::vector<
     }
     cv::Mat x;
     if (!cv::solve(a, b, x, cv::DECOMP_LU)) {
-        // Coincident centres (or, for the thin-plate kernel, all centres on one plane) make the system singular.
-        throw std::runtime_error("RBF system is singular: feature vertices coincide or are degenerate");
+        // Singular. With the thin-plate kernel that happens when every centre lies on one plane (one view's
+        // profile points all sit on the head's mid-plane): the affine part along the plane's normal is then free,
+        // and the minimum-norm solution (SVD) leaves it at zero while still interpolating every centre exactly.
+        // Coincident centres stay an error: no solution interpolates two different displacements at one point.
+        if (!affine || !cv::solve(a, b, x, cv::DECOMP_SVD))
+            throw std::runtime_error("RBF system is singular: feature vertices coincide or are degenerate");
+        const double residual = cv::norm(a * x - b, cv::NORM_INF);
+        if (!(residual <= 1e-6 * std::max(1.0, cv::norm(b, cv::NORM_INF))))
+            throw std::runtime_error("RBF system is singular: feature vertices coincide or are degenerate");
     }
     weights_.assign(n, std::vector<double>(dims_));
     for (std::size_t j = 0; j < n; ++j)

@@ -32,6 +32,8 @@
 #include <functional>
 #include <mutex>
 #include <random>
+
+#include <sys/resource.h>
 #include <thread>
 
 namespace avatarbooth {
@@ -390,6 +392,12 @@ std::string newSessionId() {
     return id;
 }
 
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+}
+
 void writeScreenshot(const fs::path& dir, int index, ScreenId id, const cv::Mat& frame, KioskReport& report) {
     char name[64];
     std::snprintf(name, sizeof name, "%02d_%s.png", index, toString(id));
@@ -469,6 +477,13 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     int screenshotIndex = 0;
     std::vector<std::pair<Button, FlowTime>> releases;  // simulated presses to release
     auto lastRetention = std::chrono::steady_clock::now();
+    // Benchmark figures.
+    int guideFrames = 0, analyses = 0;
+    double guideSeconds = 0.0;
+    std::vector<double> revealFrameSeconds, captureToReveal;
+    // (Plain time points with a flag: gcc 12 takes optional<time_point> for maybe-uninitialised here.)
+    std::chrono::steady_clock::time_point sideTakenAt{}, lastGuideFrame{};
+    bool sideTaken = false, inGuide = false;
     auto lastWatchdog = std::chrono::steady_clock::time_point{};
     bool ready = false;
 
@@ -494,6 +509,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                         spdlog::info("{} photo taken: {}x{}", c.photo == Photo::Front ? "front" : "side",
                                      still.image.cols, still.image.rows);
                         events.push_back(CaptureDone{c.photo, now});
+                        if (c.photo == Photo::Side) {
+                            sideTakenAt = std::chrono::steady_clock::now();
+                            sideTaken = true;
+                        }
                     } catch (const std::exception& e) {
                         spdlog::warn("capture failed: {}", e.what());
                         events.push_back(CaptureFailed{c.photo, e.what(), now});
@@ -613,7 +632,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                 throw BoothError(ErrorKind::BadConfig, config.fit.settings.landmarkModel.string(), *error);
             }
         }
-        if (auto analysed = previews.take()) events.push_back(*analysed);
+        if (auto analysed = previews.take()) {
+            events.push_back(*analysed);
+            ++analyses;
+        }
 
         // The fit: started once the model is there and the analysis has let go of the detector.
         if (fitWanted && fitter.pipeline()) {
@@ -663,6 +685,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         lamps.update(clock.now());
 
         // The screen.
+        const auto drawStart = std::chrono::steady_clock::now();
         ScreenInputs inputs;
         const bool previewScreen = screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide ||
                                    screen.id == ScreenId::Countdown;
@@ -683,6 +706,24 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
         const cv::Mat& drawn = screens.draw(screen, inputs);
         display.present(drawn);
+        const auto drawEnd = std::chrono::steady_clock::now();
+        if (screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide) {
+            if (inGuide) {  // frame intervals within one guide
+                ++guideFrames;
+                guideSeconds += Seconds(drawEnd - lastGuideFrame).count();
+            }
+            lastGuideFrame = drawEnd;
+            inGuide = true;
+        } else {
+            inGuide = false;
+        }
+        if (screen.id == ScreenId::Reveal && !inputs.avatar.empty()) {
+            revealFrameSeconds.push_back(Seconds(drawEnd - drawStart).count());
+            if (sideTaken) {
+                captureToReveal.push_back(Seconds(drawEnd - sideTakenAt).count());
+                sideTaken = false;
+            }
+        }
         if (screen.id != lastScreen) {
             lastScreen = screen.id;
             screenshotDue = !options.screenshots.empty();
@@ -720,6 +761,13 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         if (std::chrono::steady_clock::now() > nextFrame + 4 * kFramePeriod) nextFrame = std::chrono::steady_clock::now();
     }
     sd_notify(0, "STOPPING=1");
+    report.guideFramesPerSecond = guideSeconds > 0.0 ? guideFrames / guideSeconds : 0.0;
+    report.analysesPerSecond = guideSeconds > 0.0 ? analyses / guideSeconds : 0.0;
+    report.sideCaptureToRevealSeconds = median(captureToReveal);
+    report.revealFrameMilliseconds = 1000.0 * median(revealFrameSeconds);
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    report.peakRssMegabytes = static_cast<double>(usage.ru_maxrss) / 1024.0;
     // Leave nothing of a visitor who was still in the middle of a session.
     if (!pendingFolder.empty()) store.discard(pendingFolder);
     return report;

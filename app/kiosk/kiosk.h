@@ -44,6 +44,12 @@ struct KioskReport {
     std::filesystem::path sessionsDirectory;
     std::vector<std::string> devices;             // what was opened, one line each (as logged at start-up)
     double startupToReadySeconds = 0.0;           // to the attract screen and READY=1
+    // Figures for the benchmark (printed by `avatarbooth run`; medians where several were measured).
+    double guideFramesPerSecond = 0.0;            // screens drawn and presented per second during the guides
+    double analysesPerSecond = 0.0;               // preview analyses (face guidance) per second during the guides
+    double sideCaptureToRevealSeconds = 0.0;      // the side photo taken -> the avatar on the reveal screen
+    double revealFrameMilliseconds = 0.0;         // one reveal frame: avatar render + screen + present
+    double peakRssMegabytes = 0.0;                // of the whole process (getrusage)
 };
 
 // Runs the booth until options.sessions have ended or options.stop is set. Throws BoothError when a device or the

@@ -193,3 +193,20 @@ TEST(FitCli, HelpAndUsageErrors) {
     EXPECT_EQ(kernel.exitCode, 6) << kernel.output;
     EXPECT_NE(kernel.output.find("--kernel"), std::string::npos) << kernel.output;
 }
+
+TEST(FitCli, ConfigFileGivesTheFitSettingsAndItsMistakesAreNamed) {
+    const fs::path dir = scratchDir("e2e_fit_config");
+    std::ofstream(dir / "booth.toml") << "[fit]\n\nrbf_kernel = \"cubic\"\n";
+    const CommandResult bad = run(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", dir / "session") + " --config " +
+                                  (dir / "booth.toml").string());
+    EXPECT_EQ(bad.exitCode, 6) << bad.output;
+    EXPECT_NE(bad.output.find("booth.toml:3: fit.rbf_kernel: \"cubic\" is not one of"), std::string::npos) << bad.output;
+    EXPECT_FALSE(fs::exists(dir / "session"));
+    std::ofstream(dir / "booth.toml") << "[fit]\nrbf_kernel = \"tps\"\n";
+    const CommandResult good = run(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", dir / "session") +
+                                   " --config " + (dir / "booth.toml").string());
+    ASSERT_EQ(good.exitCode, 0) << good.output;
+    std::ifstream report(dir / "session" / "fit.json");
+    const std::string text((std::istreambuf_iterator<char>(report)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("\"tps\""), std::string::npos) << "the config's kernel was not used";
+}

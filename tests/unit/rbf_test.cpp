@@ -111,3 +111,14 @@ TEST(Rbf, KernelNamesRoundTrip) {
         EXPECT_EQ(parseRbfKernel(rbfKernelName(k)), k);
     EXPECT_THROW(parseRbfKernel("cubic"), std::invalid_argument);
 }
+
+// All centres on one plane (a view's profile points on the head's mid-plane): the thin-plate system is singular
+// along the plane's normal, and the warp still interpolates every centre exactly, with no tilt out of the plane.
+TEST(Rbf, ThinPlateWithCoplanarCentresStillInterpolatesExactly) {
+    const std::vector<glm::dvec3> centres = {{0, 0, 0}, {0, 40, 10}, {0, -30, 25}, {0, 15, -35}, {0, 60, 60}, {0, -50, -20}};
+    const std::vector<std::vector<double>> w = {{1.0}, {-2.0}, {0.5}, {3.0}, {0.0}, {-1.5}};
+    const RbfWarp warp(centres, w, options(RbfKernel::ThinPlate));
+    for (std::size_t k = 0; k < centres.size(); ++k) EXPECT_NEAR(warp.evaluate(centres[k])[0], w[k][0], 1e-9);
+    // Symmetric about the plane: nothing in the data says which side is which.
+    EXPECT_NEAR(warp.evaluate({20, 10, 5})[0], warp.evaluate({-20, 10, 5})[0], 1e-9);
+}
