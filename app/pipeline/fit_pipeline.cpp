@@ -61,6 +61,8 @@ std::string photoExtension(const fs::path& p) {
 FitPipeline::FitPipeline(FitSettings settings, const BaseHead& base) : settings_(std::move(settings)), base_(base) {
     const auto t0 = Clock::now();
     detector_ = std::make_unique<LandmarkDetector>(settings_.landmarkModel);
+    // The texture step's per-UV-layout tables, built here with the other one-off loading, not for the first visitor.
+    prepareTexture(base_.mesh, settings_.texture);
     modelLoadSeconds_ = secondsSince(t0);
 }
 

@@ -46,7 +46,7 @@ struct FitOutcome {
 
 class FitPipeline {
 public:
-    // Loads the landmark model (1-2 s): build one pipeline and reuse it.
+    // Loads the landmark model (1-2 s) and builds the texture step's UV tables: build one pipeline and reuse it.
     explicit FitPipeline(FitSettings settings, const BaseHead& base = builtinBaseHead());
     ~FitPipeline();
 
