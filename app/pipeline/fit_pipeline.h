@@ -41,6 +41,9 @@ struct FitOutcome {
     HeadFit fit;
     PhotoTexture texture;
     std::vector<std::pair<std::string, double>> stageSeconds;  // in order
+    // Processor time of each stage, all threads together (on a shared machine wall times vary with the load; this
+    // is the work itself). Same order and names as stageSeconds.
+    std::vector<std::pair<std::string, double>> stageCpuSeconds;
     std::vector<std::string> warnings;
 };
 
