@@ -11,8 +11,8 @@ namespace avatarbooth {
 
 struct PhotoTextureOptions {
     int size = 1024;
-    // Exponent on the cosine between surface normal and view direction: a photo's weight at a texel. The texel
-    // goes to the photo of larger weight; the weights also pick where the two photos' exposures are compared.
+    // Exponent on the cosine between surface normal and view direction: a photo's weight at a texel, which decides
+    // (with frontPreference) which of the two photos a texel both see takes.
     double angleStrictness = 2.0;
     // How much the front photo is preferred: a texel both photos see goes to the side photo only where the side
     // weight exceeds frontPreference times the front weight (with cos^2 weights and 4: where the surface turns more
@@ -20,7 +20,8 @@ struct PhotoTextureOptions {
     // photo's colour lands through the fitted depth z, which off the profile line is the base head's guess, so on
     // the face (cheeks by the nose and mouth) it is the less trustworthy of the two.
     double frontPreference = 4.0;
-    // Bands of the multi-band blend across the seam (more = a wider, softer transition of the low frequencies).
+    // Bands of the multi-band blend across the seam (more = a wider, softer transition of the low frequencies): the
+    // finest switches at the seam at full resolution, the others are OpenCV's MultiBandBlender at half resolution.
     int blendBands = 5;
     // Depth tolerance of the visibility test in millimetres, on top of what the pixel size and slope allow.
     double depthToleranceMm = 2.0;
