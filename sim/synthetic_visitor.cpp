@@ -227,7 +227,7 @@ SyntheticVisitor makeSyntheticVisitor(const BaseHead& base, MeshRenderer& render
     v.sideCamera = RenderCamera::orthographic(target + glm::dvec3(sideSign * 800, 0, 0), target, {0, 1, 0},
                                               options.mmPerPixel, w, h);
     v.frontCamera.background = v.sideCamera.background = cv::Scalar(0, 0, 0);
-    v.frontCamera.lit = v.sideCamera.lit = true;
+    v.frontCamera.lit = v.sideCamera.lit = options.lit;
 
     renderer.upload(v.truthMesh, v.texture);
     v.background = makeBackdrop(options.imageSize, options.seed);

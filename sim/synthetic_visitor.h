@@ -26,6 +26,8 @@ struct SyntheticVisitorOptions {
     cv::Size imageSize{972, 720};
     bool sideNoseImageRight = true; // which way the profile faces in the side photo
     int textureSize = 1024;
+    // false: the photos show the painted colours exactly, without shading (to check texturing against the paint).
+    bool lit = true;
 };
 
 struct SyntheticVisitor {

@@ -42,6 +42,9 @@ struct FitOutcome {
     HeadFit fit;
     PhotoTexture texture;
     std::vector<std::pair<std::string, double>> stageSeconds;  // in order
+    // Processor time of each stage, all threads together (on a shared machine wall times vary with the load; this
+    // is the work itself). Same order and names as stageSeconds.
+    std::vector<std::pair<std::string, double>> stageCpuSeconds;
     std::vector<std::string> warnings;
 };
 
@@ -51,7 +54,7 @@ using StageListener = std::function<void(const std::string& stage)>;
 
 class FitPipeline {
 public:
-    // Loads the landmark model (1-2 s): build one pipeline and reuse it.
+    // Loads the landmark model (1-2 s) and builds the texture step's UV tables: build one pipeline and reuse it.
     explicit FitPipeline(FitSettings settings, const BaseHead& base = builtinBaseHead());
     ~FitPipeline();
 

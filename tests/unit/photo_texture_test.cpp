@@ -1,0 +1,321 @@
+// The texture step on synthetic geometry with analytic photos: occlusion (a texel hidden from a photo does not take
+// its colour), the multi-band seam (no step where the photos agree, a gradual one where they do not), the fill.
+#include "head/photo_texture.h"
+#include "head/surface_texels.h"
+#include "head/view_depth.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <functional>
+
+using namespace avatarbooth;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Appends a square grid of quads: centre c, spanning +-half along axes a and b, UVs in the rectangle uv. The
+// triangles are turned to face `outward`.
+void addSquare(Mesh& mesh, glm::dvec3 c, glm::dvec3 a, glm::dvec3 b, double half, cv::Rect2d uv, glm::dvec3 outward) {
+    constexpr int n = 16;
+    const auto base = static_cast<std::uint32_t>(mesh.positions.size());
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) {
+            const double s = -1.0 + 2.0 * i / n, t = -1.0 + 2.0 * j / n;
+            mesh.positions.push_back(c + half * s * a + half * t * b);
+            mesh.uvs.push_back({uv.x + uv.width * i / n, uv.y + uv.height * (n - j) / n});
+        }
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const std::uint32_t v00 = base + static_cast<std::uint32_t>(j * (n + 1) + i), v10 = v00 + 1;
+            const std::uint32_t v01 = v00 + static_cast<std::uint32_t>(n + 1), v11 = v01 + 1;
+            for (glm::uvec3 t : {glm::uvec3(v00, v10, v11), glm::uvec3(v00, v11, v01)}) {
+                const glm::dvec3 normal = glm::cross(mesh.positions[t.y] - mesh.positions[t.x], mesh.positions[t.z] - mesh.positions[t.x]);
+                if (glm::dot(normal, outward) < 0.0) std::swap(t.y, t.z);
+                mesh.triangles.push_back(t);
+            }
+        }
+}
+
+// A UV sphere (longitude -> u with the seam at the back, latitude -> v), radius r, centred at the origin.
+Mesh uvSphere(double r, int rows = 48, int cols = 96) {
+    Mesh mesh;
+    for (int j = 0; j <= rows; ++j)
+        for (int i = 0; i <= cols; ++i) {
+            const double u = static_cast<double>(i) / cols, v = static_cast<double>(j) / rows;
+            const double lat = kPi * v, lon = 2.0 * kPi * (u - 0.5);
+            mesh.positions.push_back({r * std::sin(lat) * std::sin(lon), r * std::cos(lat), r * std::sin(lat) * std::cos(lon)});
+            mesh.uvs.push_back({u, v});
+        }
+    for (int j = 0; j < rows; ++j)
+        for (int i = 0; i < cols; ++i) {
+            const auto v00 = static_cast<std::uint32_t>(j * (cols + 1) + i), v10 = v00 + 1;
+            const auto v01 = v00 + static_cast<std::uint32_t>(cols + 1), v11 = v01 + 1;
+            for (glm::uvec3 t : {glm::uvec3(v00, v01, v11), glm::uvec3(v00, v11, v10)}) {
+                const glm::dvec3 centroid = (mesh.positions[t.x] + mesh.positions[t.y] + mesh.positions[t.z]) / 3.0;
+                const glm::dvec3 normal = glm::cross(mesh.positions[t.y] - mesh.positions[t.x], mesh.positions[t.z] - mesh.positions[t.x]);
+                if (glm::dot(normal, centroid) < 0.0) std::swap(t.y, t.z);
+                mesh.triangles.push_back(t);
+            }
+        }
+    return mesh;
+}
+
+// Both photos 400 x 400 at 0.5 mm per pixel, centred on the origin, the side photo seen from -x (not mirrored).
+HeadFit photoFrames() {
+    HeadFit fit;
+    fit.front = PhotoFrame{cv::Point2d(200, 200), 0.5, glm::dvec2(0.0), false, 400};
+    fit.side = PhotoFrame{cv::Point2d(200, 200), 0.5, glm::dvec2(0.0), false, 400};
+    return fit;
+}
+
+const cv::Vec3b kGreen(40, 200, 40), kRed(40, 40, 220), kBlue(200, 60, 40);
+
+// An orthographic photo of flat squares: `paint` gives the colour of each photo pixel (its plane coordinates in mm).
+cv::Mat paintPhoto(const HeadFit& fit, bool side, const std::function<cv::Vec3b(glm::dvec2)>& paint) {
+    cv::Mat photo(400, 400, CV_8UC3);
+    for (int v = 0; v < photo.rows; ++v)
+        for (int u = 0; u < photo.cols; ++u)
+            photo.at<cv::Vec3b>(v, u) = paint((side ? fit.side : fit.front).toHead(cv::Point2d(u, v)));
+    return photo;
+}
+
+cv::Vec3d meanWhere(const cv::Mat& image, const cv::Mat& mask) {
+    const cv::Scalar m = cv::mean(image, mask);
+    return {m[0], m[1], m[2]};
+}
+
+// Texels of the mesh's squares whose UVs fall in a rectangle (fractions of the texture).
+cv::Mat uvRegion(int size, cv::Rect2d uv) {
+    cv::Mat mask(size, size, CV_8U, cv::Scalar(0));
+    mask(cv::Rect(static_cast<int>(uv.x * size), static_cast<int>(uv.y * size), static_cast<int>(uv.width * size),
+                  static_cast<int>(uv.height * size)))
+        .setTo(255);
+    return mask;
+}
+
+}  // namespace
+
+// Two parallel squares facing the front camera: a small one 20 mm in front of a large one. The front photo shows
+// the small one red on the large one's green. The part of the large square behind the small one is hidden from the
+// front photo: it must not take the red (before the visibility test it did), but a fill from the green around it.
+TEST(PhotoTexture, TexelHiddenBehindAnotherSurfaceDoesNotTakeThatPhotosColour) {
+    Mesh mesh;
+    const cv::Rect2d backUv(0.0, 0.0, 0.5, 1.0), frontUv(0.5, 0.0, 0.5, 1.0);
+    addSquare(mesh, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 60.0, backUv, {0, 0, 1});
+    addSquare(mesh, {0, 0, 20}, {1, 0, 0}, {0, 1, 0}, 20.0, frontUv, {0, 0, 1});
+    const HeadFit fit = photoFrames();
+    const cv::Mat front = paintPhoto(fit, false, [](glm::dvec2 p) { return std::abs(p.x) < 20 && std::abs(p.y) < 20 ? kRed : kGreen; });
+    const cv::Mat side(400, 400, CV_8UC3, cv::Scalar(kBlue));
+    const cv::Mat all(400, 400, CV_8U, cv::Scalar(255));
+    PhotoTextureOptions o;
+    o.size = 256;
+    const PhotoTexture t = textureFromPhotos(mesh, fit, front, all, side, all, o);
+
+    // The large square spans +-60 mm over u in [0, 0.5]: +-15 mm (well inside the hidden +-20) is u 0.1875..0.3125.
+    const cv::Mat hidden = uvRegion(o.size, {0.19, 0.38, 0.12, 0.24});
+    const cv::Mat seenBack = uvRegion(o.size, {0.02, 0.05, 0.08, 0.9});   // x < -45 mm: seen
+    const cv::Mat seenFront = uvRegion(o.size, {0.55, 0.1, 0.4, 0.8});    // the small square itself
+    const cv::Vec3d hiddenColour = meanWhere(t.texture, hidden);
+    std::printf("hidden texels: BGR (%.0f, %.0f, %.0f); small square (%.0f, %.0f, %.0f)\n", hiddenColour[0], hiddenColour[1],
+                hiddenColour[2], meanWhere(t.texture, seenFront)[0], meanWhere(t.texture, seenFront)[1], meanWhere(t.texture, seenFront)[2]);
+    EXPECT_EQ(cv::countNonZero((t.source != PhotoTexture::Filled) & hidden), 0) << "a hidden texel was taken from a photo";
+    EXPECT_LT(hiddenColour[2], 90.0) << "the hidden texels took the red of the square in front of them";
+    EXPECT_GT(hiddenColour[1], 150.0) << "the hidden texels should be filled from the green around them";
+    EXPECT_EQ(cv::countNonZero((t.source != PhotoTexture::Front) & seenBack), 0);
+    EXPECT_LT(cv::norm(meanWhere(t.texture, seenBack) - cv::Vec3d(kGreen[0], kGreen[1], kGreen[2])), 6.0);
+    EXPECT_LT(cv::norm(meanWhere(t.texture, seenFront) - cv::Vec3d(kRed[0], kRed[1], kRed[2])), 6.0);
+}
+
+// The same from the side camera (-x), and from the other side (+x), which the side photo stands in for mirrored: the
+// large square's part behind the small one must not take the small one's colour from the side photo.
+TEST(PhotoTexture, TexelHiddenFromTheSidePhotoOnEitherSide) {
+    for (const double sign : {-1.0, 1.0}) {
+        Mesh mesh;
+        addSquare(mesh, {0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 60.0, {0.0, 0.0, 0.5, 1.0}, {sign, 0, 0});
+        addSquare(mesh, {sign * 20, 0, 0}, {0, 0, 1}, {0, 1, 0}, 20.0, {0.5, 0.0, 0.5, 1.0}, {sign, 0, 0});
+        const HeadFit fit = photoFrames();
+        const cv::Mat front(400, 400, CV_8UC3, cv::Scalar(kBlue));
+        const cv::Mat side = paintPhoto(fit, true, [](glm::dvec2 p) { return std::abs(p.x) < 20 && std::abs(p.y) < 20 ? kRed : kGreen; });
+        const cv::Mat all(400, 400, CV_8U, cv::Scalar(255));
+        PhotoTextureOptions o;
+        o.size = 256;
+        const PhotoTexture t = textureFromPhotos(mesh, fit, front, all, side, all, o);
+        // The large square's u runs along z (either way, by the sign): its middle +-15 mm is hidden either way.
+        const cv::Mat hidden = uvRegion(o.size, {0.19, 0.38, 0.12, 0.24});
+        const cv::Vec3d hiddenColour = meanWhere(t.texture, hidden);
+        EXPECT_EQ(cv::countNonZero((t.source != PhotoTexture::Filled) & hidden), 0) << "side " << sign;
+        EXPECT_LT(hiddenColour[2], 90.0) << "side " << sign;
+        EXPECT_GT(hiddenColour[1], 150.0) << "side " << sign;
+        EXPECT_GT(cv::countNonZero(t.source == PhotoTexture::Side), o.size * o.size / 4) << "side " << sign;
+    }
+}
+
+namespace {
+
+// A smooth colour over head space, the same on both sides (x -> -x), as the mirrored side photo assumes.
+cv::Vec3d sphereColour(const glm::dvec3& p) {
+    return {128.0 + 50.0 * std::sin(p.y / 15.0), 128.0 + 50.0 * std::cos(p.z / 18.0), 128.0 + 40.0 * std::sin(std::abs(p.x) / 12.0)};
+}
+
+constexpr double kRadius = 80.0;
+
+// The sphere seen by the front camera (+z) or the side camera (-x); `shade` scales the colour per visible point.
+cv::Mat spherePhoto(const HeadFit& fit, bool side, cv::Mat& mask, const std::function<double(glm::dvec3)>& shade) {
+    cv::Mat photo(400, 400, CV_8UC3, cv::Scalar(20, 20, 20));
+    mask = cv::Mat(400, 400, CV_8U, cv::Scalar(0));
+    for (int v = 0; v < 400; ++v)
+        for (int u = 0; u < 400; ++u) {
+            const glm::dvec2 q = (side ? fit.side : fit.front).toHead(cv::Point2d(u, v));
+            const double rest = kRadius * kRadius - q.x * q.x - q.y * q.y;
+            if (rest <= 0.0) continue;
+            const glm::dvec3 p = side ? glm::dvec3(-std::sqrt(rest), q.y, q.x) : glm::dvec3(q.x, q.y, std::sqrt(rest));
+            const cv::Vec3d c = sphereColour(p) * shade(p);
+            photo.at<cv::Vec3b>(v, u) = cv::Vec3b(cv::saturate_cast<unsigned char>(c[0]), cv::saturate_cast<unsigned char>(c[1]),
+                                                  cv::saturate_cast<unsigned char>(c[2]));
+            mask.at<unsigned char>(v, u) = 255;
+        }
+    return photo;
+}
+
+struct SeamStats {
+    double acrossSeam = 0.0;   // mean colour difference of neighbouring texels taken from different photos
+    double withinFront = 0.0;  // the same for neighbouring texels both from the front photo
+    int seamPairs = 0;
+    double truthError = 0.0;   // mean |texture - true colour| over the texels a photo saw
+};
+
+SeamStats seamStats(const Mesh& mesh, const PhotoTexture& t) {
+    const SurfaceTexels texels = sampleSurfaceTexels(mesh, mesh.vertexNormals(), t.texture.size());
+    SeamStats s;
+    double within = 0.0, truth = 0.0;
+    int withinPairs = 0, seen = 0;
+    for (int y = 0; y + 1 < t.texture.rows; ++y)
+        for (int x = 0; x + 1 < t.texture.cols; ++x) {
+            const unsigned char a = t.source.at<unsigned char>(y, x);
+            if (a == PhotoTexture::Filled) continue;
+            const cv::Vec3d ca = t.texture.at<cv::Vec3b>(y, x);
+            const cv::Vec3f p = texels.position.at<cv::Vec3f>(y, x);
+            truth += cv::norm(ca - sphereColour({p[0], p[1], p[2]})) / std::sqrt(3.0);
+            ++seen;
+            for (const cv::Point n : {cv::Point(x + 1, y), cv::Point(x, y + 1)}) {
+                const unsigned char b = t.source.at<unsigned char>(n);
+                if (b == PhotoTexture::Filled) continue;
+                const double d = cv::norm(ca - cv::Vec3d(t.texture.at<cv::Vec3b>(n))) / std::sqrt(3.0);
+                if (a != b) {
+                    s.acrossSeam += d;
+                    ++s.seamPairs;
+                } else if (a == PhotoTexture::Front) {
+                    within += d;
+                    ++withinPairs;
+                }
+            }
+        }
+    s.acrossSeam /= std::max(s.seamPairs, 1);
+    s.withinFront = within / std::max(withinPairs, 1);
+    s.truthError = truth / std::max(seen, 1);
+    return s;
+}
+
+}  // namespace
+
+// Both photos show the same colours (the sphere's own): the texture reproduces them, and the seam between the
+// front and the side photo's texels is no step: neighbours across it differ no more than neighbours elsewhere.
+TEST(PhotoTexture, SeamHasNoStepWherePhotosAgree) {
+    const Mesh sphere = uvSphere(kRadius);
+    const HeadFit fit = photoFrames();
+    cv::Mat frontMask, sideMask;
+    const auto same = [](const glm::dvec3&) { return 1.0; };
+    const cv::Mat front = spherePhoto(fit, false, frontMask, same), side = spherePhoto(fit, true, sideMask, same);
+    PhotoTextureOptions o;
+    o.size = 512;
+    const PhotoTexture t = textureFromPhotos(sphere, fit, front, frontMask, side, sideMask, o);
+    const SeamStats s = seamStats(sphere, t);
+    std::printf("agreeing photos: %d seam pairs, step across the seam %.2f, between front texels %.2f, error vs truth %.2f\n",
+                s.seamPairs, s.acrossSeam, s.withinFront, s.truthError);
+    ASSERT_GT(s.seamPairs, 500) << "the sphere should have a front/side seam";
+    EXPECT_LT(s.acrossSeam, 2.0 * s.withinFront + 1.0);
+    EXPECT_LT(s.truthError, 1.5);
+    EXPECT_GT(t.seenFraction, 0.7);  // a sphere: neither photo sees the back, nor the top and bottom beyond 80 degrees
+}
+
+// The side photo is lit differently, brighter and darker in bands from top to bottom (no single gain can match it).
+// A hard switch between the photos would step by the whole difference at the seam; the multi-band blend spreads the
+// low frequencies over a wide band, so neighbours across the seam differ far less than the photos do.
+TEST(PhotoTexture, SeamIsBlendedWherePhotosDisagree) {
+    const Mesh sphere = uvSphere(kRadius);
+    const HeadFit fit = photoFrames();
+    cv::Mat frontMask, sideMask;
+    const auto same = [](const glm::dvec3&) { return 1.0; };
+    const auto banded = [](const glm::dvec3& p) { return 1.0 + 0.3 * std::sin(p.y / 20.0); };
+    const cv::Mat front = spherePhoto(fit, false, frontMask, same), side = spherePhoto(fit, true, sideMask, banded);
+    PhotoTextureOptions o;
+    o.size = 512;
+    const PhotoTexture t = textureFromPhotos(sphere, fit, front, frontMask, side, sideMask, o);
+    const SeamStats s = seamStats(sphere, t);
+
+    // The step a hard switch would make: the two photos' difference at the seam texels.
+    const SurfaceTexels texels = sampleSurfaceTexels(sphere, sphere.vertexNormals(), t.texture.size());
+    double raw = 0.0;
+    int n = 0;
+    for (int y = 0; y + 1 < t.texture.rows; ++y)
+        for (int x = 0; x + 1 < t.texture.cols; ++x) {
+            const unsigned char a = t.source.at<unsigned char>(y, x), b = t.source.at<unsigned char>(y, x + 1);
+            if (a == PhotoTexture::Filled || b == PhotoTexture::Filled || a == b) continue;
+            const cv::Vec3f q = texels.position.at<cv::Vec3f>(y, x);
+            const glm::dvec3 p(q[0], q[1], q[2]);
+            raw += cv::norm(sphereColour(p) * (banded(p) - 1.0)) / std::sqrt(3.0);
+            ++n;
+        }
+    raw /= std::max(n, 1);
+    std::printf("disagreeing photos: photos differ by %.1f at the seam; step across the seam %.2f, between front texels %.2f\n",
+                raw, s.acrossSeam, s.withinFront);
+    ASSERT_GT(n, 100);
+    EXPECT_GT(raw, 12.0) << "the test's photos should disagree at the seam";
+    EXPECT_LT(s.acrossSeam, 0.15 * raw);
+    EXPECT_LT(s.acrossSeam, 2.0 * s.withinFront + 1.0);
+}
+
+// No photo sees the back of the sphere: it is filled from the colours around it, not left black.
+TEST(PhotoTexture, UnseenTexelsAreFilledWithSurroundingColours) {
+    const Mesh sphere = uvSphere(kRadius);
+    const HeadFit fit = photoFrames();
+    cv::Mat frontMask, sideMask;
+    const auto same = [](const glm::dvec3&) { return 1.0; };
+    const cv::Mat front = spherePhoto(fit, false, frontMask, same), side = spherePhoto(fit, true, sideMask, same);
+    PhotoTextureOptions o;
+    o.size = 256;
+    const PhotoTexture t = textureFromPhotos(sphere, fit, front, frontMask, side, sideMask, o);
+    const cv::Mat filled = t.source == PhotoTexture::Filled;
+    ASSERT_GT(cv::countNonZero(filled), 1000) << "the back of the sphere is seen by neither photo";
+    cv::Mat grey;
+    cv::cvtColor(t.texture, grey, cv::COLOR_BGR2GRAY);
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(grey, &lo, &hi, nullptr, nullptr, filled);
+    // The sphere's colours run from about 40 to 215 per channel; the fill stays among them.
+    EXPECT_GT(lo, 50.0);
+    EXPECT_LT(hi, 215.0);
+}
+
+TEST(PhotoTexture, PullPushFillsHolesFromTheirSurroundings) {
+    cv::Mat colour(64, 64, CV_32FC3, cv::Scalar(10, 100, 200)), weight(64, 64, CV_32F, cv::Scalar(1));
+    colour(cv::Rect(20, 20, 24, 24)).setTo(cv::Scalar::all(0));
+    weight(cv::Rect(20, 20, 24, 24)).setTo(0.0f);
+    pullPushFill(colour, weight);
+    const cv::Scalar m = cv::mean(colour(cv::Rect(20, 20, 24, 24)));
+    EXPECT_NEAR(m[0], 10.0, 0.5);
+    EXPECT_NEAR(m[1], 100.0, 0.5);
+    EXPECT_NEAR(m[2], 200.0, 0.5);
+    EXPECT_EQ(cv::countNonZero(weight != 1.0f), 0);
+}
+
+// The z-buffer: the nearer of two overlapping triangles wins, and pixels no triangle covers stay at -infinity.
+TEST(ViewDepth, NearestTriangleWins) {
+    const std::vector<ViewVertex> v = {{10, 10, 1}, {90, 10, 1}, {10, 90, 1}, {10, 10, 5}, {90, 10, 5}, {10, 90, 5}};
+    const std::vector<glm::uvec3> t = {{0, 1, 2}, {3, 5, 4}};  // either winding
+    const cv::Mat z = rasteriseNearestDepth(v, t, cv::Size(100, 100));
+    EXPECT_FLOAT_EQ(z.at<float>(20, 20), 5.0f);
+    EXPECT_TRUE(std::isinf(z.at<float>(95, 95)) && z.at<float>(95, 95) < 0);
+}
