@@ -116,10 +116,14 @@ Regions splitRegions(const cv::Mat& drawingBgr, const cv::Mat& mask, const cv::M
     cv::bitwise_not(out.labels != 0, source);  // distanceTransform measures to the zero (region) pixels
     cv::Mat dist, nearest;
     cv::distanceTransform(source, dist, nearest, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
-    std::vector<int> regionOfZero(1, 0);
+    // A region pixel carries its own pixel label: that gives the label -> region table.
+    double maxLabel = 0.0;
+    cv::minMaxLoc(nearest, nullptr, &maxLabel);
+    std::vector<int> regionOfZero(static_cast<std::size_t>(maxLabel) + 1, 0);
     for (int r = 0; r < rows; ++r)
         for (int c = 0; c < cols; ++c)
-            if (source.at<uchar>(r, c) == 0) regionOfZero.push_back(out.labels.at<int>(r, c));
+            if (source.at<uchar>(r, c) == 0)
+                regionOfZero[static_cast<std::size_t>(nearest.at<int>(r, c))] = out.labels.at<int>(r, c);
     for (int r = 0; r < rows; ++r)
         for (int c = 0; c < cols; ++c)
             if (notRegion.at<uchar>(r, c)) {
