@@ -85,12 +85,12 @@ ContourCorrespondence correspondContours(const Region& a, const Region& b, int p
 
 ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const DrawingView& viewA,
                          const cv::Mat& drawingB, const cv::Mat& maskB, const DrawingView& viewB,
-                         const cv::Mat& outlineA, const cv::Mat& outlineB) {
+                         const cv::Mat& outlineA, const cv::Mat& outlineB, int minRegionArea) {
     ToonModel model;
     model.viewA = viewA;
     model.viewB = viewB;
-    model.regionsA = splitRegions(drawingA, maskA, outlineA);
-    model.regionsB = splitRegions(drawingB, maskB, outlineB);
+    model.regionsA = splitRegions(drawingA, maskA, outlineA, 60, minRegionArea);
+    model.regionsB = splitRegions(drawingB, maskB, outlineB, 60, minRegionArea);
     const auto match = matchRegions(model.regionsA, model.regionsB, viewA.direction, viewB.direction);
     for (std::size_t i = 0; i < match.size(); ++i) {
         if (!match[i]) continue;
@@ -127,7 +127,9 @@ cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double 
         items.push_back({glm::dot(pos, towards), area, k, pos});
     }
     // Painter's order: far first; at equal depth the larger region first, so inner parts stay on top.
-    std::sort(items.begin(), items.end(), [](const Item& x, const Item& y) {
+    const std::size_t backdrops = model.backdropPairs;
+    std::sort(items.begin(), items.end(), [backdrops](const Item& x, const Item& y) {
+        if ((x.pair < backdrops) != (y.pair < backdrops)) return x.pair < backdrops;
         if (std::abs(x.depth - y.depth) > 1e-9) return x.depth < y.depth;
         return x.area > y.area;
     });
@@ -182,9 +184,35 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
     a.centre = frontCentre;
     b.direction = {90.0, 0.0};
     b.centre = sideCentre;
-    return buildToonModel(front.bgr, front.mask, a, side.bgr, side.mask, b, front.outline, side.outline);
+    // Photos give many small shading patches that no view shares: keep regions of at least 1/400 of the head's
+    // height squared (a 16 px square at 320 px), the size of an eye's parts.
+    ToonModel model = buildToonModel(front.bgr, front.mask, a, side.bgr, side.mask, b, front.outline, side.outline,
+                                     std::max(30, headHeightPx * headHeightPx / 400));
+    // The whole head as one more region per view, drawn behind the others: what stays unmatched leaves no hole.
+    auto silhouette = [](const ToonDrawing& d, Regions& regions) {
+        Region r;
+        std::vector<std::vector<cv::Point>> contours;
+        cv::findContours(d.mask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+        r.contour = *std::max_element(contours.begin(), contours.end(), [](const auto& x, const auto& y) {
+            return cv::contourArea(x) < cv::contourArea(y);
+        });
+        r.bbox = cv::boundingRect(r.contour);
+        r.bboxCentre = {r.bbox.x + (r.bbox.width - 1) / 2.0, r.bbox.y + (r.bbox.height - 1) / 2.0};
+        const cv::Moments m = cv::moments(d.mask, true);
+        r.centroid = {m.m10 / m.m00, m.m01 / m.m00};
+        r.area = m.m00;
+        const cv::Scalar mean = cv::mean(d.bgr, d.mask & ~d.outline);
+        r.colour = {mean[2] / 255.0, mean[1] / 255.0, mean[0] / 255.0};
+        r.label = -1;  // not in Regions::labels
+        regions.regions.push_back(r);
+        return regions.regions.size() - 1;
+    };
+    const std::size_t ia = silhouette(front, model.regionsA), ib = silhouette(side, model.regionsB);
+    model.pairs.insert(model.pairs.begin(), placePair(model.regionsA.regions[ia], model.regionsB.regions[ib], ia, ib, a, b));
+    model.contours.insert(model.contours.begin(), correspondContours(model.regionsA.regions[ia], model.regionsB.regions[ib]));
+    model.backdropPairs = 1;
+    return model;
 }
-
 std::vector<std::filesystem::path> writeTurntable(const ToonModel& model, const std::filesystem::path& directory,
                                                   int frames, cv::Size size, double unitsPerPixel) {
     std::error_code ec;

@@ -22,11 +22,15 @@ struct ToonModel {
     Regions regionsA, regionsB;
     std::vector<PlacedPair> pairs;
     std::vector<ContourCorrespondence> contours;  // one per pair
+    // The first `backdropPairs` pairs are drawn first whatever their depth (toonFromPhotos: the whole head's
+    // silhouette, so regions left unmatched leave no holes).
+    std::size_t backdropPairs = 0;
 };
-// Splits both drawings, matches A's regions to B's, places every matched pair and corresponds its outlines.
+// Splits both drawings (regions under `minRegionArea` pixels join their neighbours), matches A's regions to B's, places every matched pair and corresponds its outlines.
 ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const DrawingView& viewA,
                          const cv::Mat& drawingB, const cv::Mat& maskB, const DrawingView& viewB,
-                         const cv::Mat& outlineA = cv::Mat(), const cv::Mat& outlineB = cv::Mat());
+                         const cv::Mat& outlineA = cv::Mat(), const cv::Mat& outlineB = cv::Mat(),
+                         int minRegionArea = 30);
 
 // Renders the billboards orthographically at `yawDeg` in [-90, 90] (0 = front, 90 = view B's side, negative =
 // the other side, drawn mirrored), far regions first, each filled with its colour and outlined dark.

@@ -33,11 +33,15 @@ TEST(ToonPhotos, SyntheticVisitorBecomesAToonTurntable) {
     ASSERT_GE(model.regionsA.regions.size(), 3u);
     ASSERT_GE(model.regionsB.regions.size(), 3u);
     ASSERT_GE(model.pairs.size(), 3u);
-    // The biggest region of each view (the skin) is matched with the other view's biggest.
+    // The whole-head backdrop pair comes first; of the drawn regions (label > 0) the biggest of each view (the
+    // skin) is matched with the other view's biggest.
+    ASSERT_EQ(model.backdropPairs, 1u);
+    EXPECT_EQ(model.regionsA.regions[model.pairs[0].regionA].label, -1);
     auto biggest = [](const Regions& r) {
-        return static_cast<std::size_t>(std::max_element(r.regions.begin(), r.regions.end(), [](const Region& a, const Region& b) {
-                   return a.area < b.area;
-               }) - r.regions.begin());
+        std::size_t best = 0;
+        for (std::size_t i = 0; i < r.regions.size(); ++i)
+            if (r.regions[i].label > 0 && (r.regions[best].label <= 0 || r.regions[i].area > r.regions[best].area)) best = i;
+        return best;
     };
     const std::size_t bigA = biggest(model.regionsA), bigB = biggest(model.regionsB);
     const auto pair = std::find_if(model.pairs.begin(), model.pairs.end(), [&](const PlacedPair& p) { return p.regionA == bigA; });
