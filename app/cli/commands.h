@@ -15,5 +15,7 @@ void registerMakeVisitorCommand(CLI::App& app);
 void registerRunCommand(CLI::App& app);
 // `avatarbooth bench`: per-stage fit times on one photo pair.
 void registerBenchCommand(CLI::App& app);
+// `avatarbooth toon`: a front + side photo pair to Kitamura's two-view toon head, as a turntable strip of PNGs.
+void registerToonCommand(CLI::App& app);
 
 }  // namespace avatarbooth

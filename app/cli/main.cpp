@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     avatarbooth::registerRunCommand(app);
     avatarbooth::registerFitCommand(app);
     avatarbooth::registerMakeBaseHeadCommand(app);
+    avatarbooth::registerToonCommand(app);
     avatarbooth::registerMakeVisitorCommand(app);
     avatarbooth::registerBenchCommand(app);
     app.parse_complete_callback([&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::warn); });

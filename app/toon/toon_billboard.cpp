@@ -1,0 +1,233 @@
+// Kitamura's two-view toon character, second half: outline correspondence, orthographic billboards, turntable.
+#include "toon/toon_billboard.h"
+
+#include "common/atomic_output.h"
+#include "common/error.h"
+#include "common/image_io.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+namespace avatarbooth::toon {
+
+namespace {
+
+// The closed outline resampled to n points equally spaced by arc length.
+std::vector<cv::Point2d> resample(const std::vector<cv::Point>& contour, int n) {
+    std::vector<cv::Point2d> out;
+    if (contour.empty()) return std::vector<cv::Point2d>(static_cast<std::size_t>(n), cv::Point2d(0, 0));
+    std::vector<double> cumulative(contour.size() + 1, 0.0);
+    for (std::size_t i = 0; i < contour.size(); ++i) {
+        const cv::Point d = contour[(i + 1) % contour.size()] - contour[i];
+        cumulative[i + 1] = cumulative[i] + std::hypot(d.x, d.y);
+    }
+    const double total = cumulative.back();
+    std::size_t seg = 0;
+    for (int k = 0; k < n; ++k) {
+        const double s = total * k / n;
+        while (seg + 1 < contour.size() && cumulative[seg + 1] <= s) ++seg;
+        const double len = cumulative[seg + 1] - cumulative[seg];
+        const double t = len > 0 ? (s - cumulative[seg]) / len : 0.0;
+        const cv::Point2d p0 = contour[seg], p1 = contour[(seg + 1) % contour.size()];
+        out.push_back(p0 + (p1 - p0) * t);
+    }
+    return out;
+}
+
+// Angle of the principal axis of a point set about its mean.
+double principalAngle(const std::vector<cv::Point2d>& pts) {
+    double sxx = 0, syy = 0, sxy = 0;
+    for (const cv::Point2d& p : pts) {
+        sxx += p.x * p.x;
+        syy += p.y * p.y;
+        sxy += p.x * p.y;
+    }
+    return 0.5 * std::atan2(2.0 * sxy, sxx - syy);
+}
+
+}  // namespace
+
+ContourCorrespondence correspondContours(const Region& a, const Region& b, int points) {
+    ContourCorrespondence out;
+    out.a = resample(a.contour, points);
+    std::vector<cv::Point2d> pb = resample(b.contour, points);
+    for (auto& p : out.a) p -= a.centroid;
+    for (auto& p : pb) p -= b.centroid;
+    // Align b's principal axis with a's (both ways round: an axis has no sign), then pick the cyclic shift.
+    const double base = principalAngle(out.a) - principalAngle(pb);
+    double bestCost = std::numeric_limits<double>::infinity();
+    int bestShift = 0;
+    for (double turn : {0.0, CV_PI}) {
+        const double c = std::cos(base + turn), s = std::sin(base + turn);
+        for (int shift = 0; shift < points; ++shift) {
+            double cost = 0.0;
+            for (int i = 0; i < points; ++i) {
+                const cv::Point2d q = pb[static_cast<std::size_t>((i + shift) % points)];
+                const cv::Point2d r(c * q.x - s * q.y, s * q.x + c * q.y);
+                const cv::Point2d d = out.a[static_cast<std::size_t>(i)] - r;
+                cost += d.dot(d);
+            }
+            if (cost < bestCost) {
+                bestCost = cost;
+                bestShift = shift;
+            }
+        }
+    }
+    out.b.resize(static_cast<std::size_t>(points));
+    for (int i = 0; i < points; ++i)
+        out.b[static_cast<std::size_t>(i)] = pb[static_cast<std::size_t>((i + bestShift) % points)];
+    return out;
+}
+
+ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const DrawingView& viewA,
+                         const cv::Mat& drawingB, const cv::Mat& maskB, const DrawingView& viewB,
+                         const cv::Mat& outlineA, const cv::Mat& outlineB, int minRegionArea) {
+    ToonModel model;
+    model.viewA = viewA;
+    model.viewB = viewB;
+    model.regionsA = splitRegions(drawingA, maskA, outlineA, 60, minRegionArea);
+    model.regionsB = splitRegions(drawingB, maskB, outlineB, 60, minRegionArea);
+    const auto match = matchRegions(model.regionsA, model.regionsB, viewA.direction, viewB.direction);
+    for (std::size_t i = 0; i < match.size(); ++i) {
+        if (!match[i]) continue;
+        const Region& a = model.regionsA.regions[i];
+        const Region& b = model.regionsB.regions[*match[i]];
+        model.pairs.push_back(placePair(a, b, i, *match[i], viewA, viewB));
+        model.contours.push_back(correspondContours(a, b));
+    }
+    return model;
+}
+
+cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel, int outlineWidth) {
+    cv::Mat canvas(size, CV_8UC3, cv::Scalar(255, 255, 255));
+    const double yaw = std::clamp(std::abs(yawDeg), 0.0, 90.0);
+    const double span = model.viewB.direction.thetaDeg - model.viewA.direction.thetaDeg;
+    const double t = span != 0.0 ? std::clamp((yaw - model.viewA.direction.thetaDeg) / span, 0.0, 1.0) : 0.0;
+    DrawingView camera;
+    camera.direction.thetaDeg = yaw;
+    camera.direction.phiDeg = (1.0 - t) * model.viewA.direction.phiDeg + t * model.viewB.direction.phiDeg;
+    camera.centre = {(size.width - 1) / 2.0, (size.height - 1) / 2.0};
+    camera.unitsPerPixel = unitsPerPixel;
+    const glm::dvec3 towards = camera.direction.towardsCamera();
+
+    struct Item {
+        double depth, area;
+        std::size_t pair;
+        glm::dvec3 position;
+    };
+    std::vector<Item> items;
+    for (std::size_t k = 0; k < model.pairs.size(); ++k) {
+        const PlacedPair& p = model.pairs[k];
+        const glm::dvec3 pos = (1.0 - t) * p.positionA + t * p.positionB;
+        const double area = (1.0 - t) * model.regionsA.regions[p.regionA].area + t * model.regionsB.regions[p.regionB].area;
+        items.push_back({glm::dot(pos, towards), area, k, pos});
+    }
+    // Painter's order: far first; at equal depth the larger region first, so inner parts stay on top.
+    const std::size_t backdrops = model.backdropPairs;
+    std::sort(items.begin(), items.end(), [backdrops](const Item& x, const Item& y) {
+        if ((x.pair < backdrops) != (y.pair < backdrops)) return x.pair < backdrops;
+        if (std::abs(x.depth - y.depth) > 1e-9) return x.depth < y.depth;
+        return x.area > y.area;
+    });
+    constexpr int kShift = 4;  // sub-pixel drawing
+    for (const Item& item : items) {
+        const PlacedPair& p = model.pairs[item.pair];
+        const ContourCorrespondence& cc = model.contours[item.pair];
+        const cv::Point2d centre = camera.project(item.position);
+        std::vector<cv::Point> poly;
+        for (std::size_t i = 0; i < cc.a.size(); ++i) {
+            const cv::Point2d off = (cc.a[i] * model.viewA.unitsPerPixel * (1.0 - t) +
+                                     cc.b[i] * model.viewB.unitsPerPixel * t) / unitsPerPixel;
+            const cv::Point2d q = (centre + off) * static_cast<double>(1 << kShift);
+            poly.emplace_back(cvRound(q.x), cvRound(q.y));
+        }
+        const cv::Vec3d rgb = (1.0 - t) * model.regionsA.regions[p.regionA].colour + t * model.regionsB.regions[p.regionB].colour;
+        const cv::Scalar bgr(rgb[2] * 255.0, rgb[1] * 255.0, rgb[0] * 255.0);
+        cv::fillPoly(canvas, std::vector<std::vector<cv::Point>>{poly}, bgr, cv::LINE_AA, kShift);
+        if (outlineWidth > 0)
+            cv::polylines(canvas, std::vector<std::vector<cv::Point>>{poly}, true, cv::Scalar(20, 20, 20), outlineWidth,
+                          cv::LINE_AA, kShift);
+    }
+    if (yawDeg < 0.0) cv::flip(canvas, canvas, 1);  // the other side: the side drawing mirrored
+    return canvas;
+}
+
+ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, const cv::Mat& sideBgr,
+                         const cv::Mat& sideMask, bool sideNoseImageRight, int colours, int headHeightPx) {
+    auto prepare = [&](const cv::Mat& bgr, const cv::Mat& mask, bool mirror, const char* which) {
+        if (bgr.empty() || mask.empty() || cv::countNonZero(mask > 127) == 0)
+            throw BoothError(ErrorKind::NoFace, which, "no head mask to draw the toon from");
+        const cv::Rect box = cv::boundingRect(mask > 127);
+        const int pad = std::max(4, box.height / 20);
+        const cv::Rect padded = (box + cv::Size(2 * pad, 2 * pad) - cv::Point(pad, pad)) & cv::Rect(0, 0, bgr.cols, bgr.rows);
+        const double scale = static_cast<double>(headHeightPx) / box.height;
+        cv::Mat photo, m;
+        cv::resize(bgr(padded), photo, cv::Size(), scale, scale, cv::INTER_AREA);
+        cv::resize(mask(padded), m, photo.size(), 0, 0, cv::INTER_NEAREST);
+        if (mirror) {
+            cv::flip(photo, photo, 1);
+            cv::flip(m, m, 1);
+        }
+        ToonDrawing drawing = toonDrawing(photo, m, colours);
+        const cv::Rect b2 = cv::boundingRect(drawing.mask);
+        return std::pair{drawing, cv::Point2d(b2.x + (b2.width - 1) / 2.0, b2.y + (b2.height - 1) / 2.0)};
+    };
+    auto [front, frontCentre] = prepare(frontBgr, frontMask, false, "front photo");
+    // Theta 90 looks from +x (the character's left): the face points to image left, so a nose-right photo flips.
+    auto [side, sideCentre] = prepare(sideBgr, sideMask, sideNoseImageRight, "side photo");
+    DrawingView a, b;
+    a.direction = {0.0, 0.0};
+    a.centre = frontCentre;
+    b.direction = {90.0, 0.0};
+    b.centre = sideCentre;
+    // Photos give many small shading patches that no view shares: keep regions of at least 1/400 of the head's
+    // height squared (a 16 px square at 320 px), the size of an eye's parts.
+    ToonModel model = buildToonModel(front.bgr, front.mask, a, side.bgr, side.mask, b, front.outline, side.outline,
+                                     std::max(30, headHeightPx * headHeightPx / 400));
+    // The whole head as one more region per view, drawn behind the others: what stays unmatched leaves no hole.
+    auto silhouette = [](const ToonDrawing& d, Regions& regions) {
+        Region r;
+        std::vector<std::vector<cv::Point>> contours;
+        cv::findContours(d.mask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+        r.contour = *std::max_element(contours.begin(), contours.end(), [](const auto& x, const auto& y) {
+            return cv::contourArea(x) < cv::contourArea(y);
+        });
+        r.bbox = cv::boundingRect(r.contour);
+        r.bboxCentre = {r.bbox.x + (r.bbox.width - 1) / 2.0, r.bbox.y + (r.bbox.height - 1) / 2.0};
+        const cv::Moments m = cv::moments(d.mask, true);
+        r.centroid = {m.m10 / m.m00, m.m01 / m.m00};
+        r.area = m.m00;
+        const cv::Scalar mean = cv::mean(d.bgr, d.mask & ~d.outline);
+        r.colour = {mean[2] / 255.0, mean[1] / 255.0, mean[0] / 255.0};
+        r.label = -1;  // not in Regions::labels
+        regions.regions.push_back(r);
+        return regions.regions.size() - 1;
+    };
+    const std::size_t ia = silhouette(front, model.regionsA), ib = silhouette(side, model.regionsB);
+    model.pairs.insert(model.pairs.begin(), placePair(model.regionsA.regions[ia], model.regionsB.regions[ib], ia, ib, a, b));
+    model.contours.insert(model.contours.begin(), correspondContours(model.regionsA.regions[ia], model.regionsB.regions[ib]));
+    model.backdropPairs = 1;
+    return model;
+}
+std::vector<std::filesystem::path> writeTurntable(const ToonModel& model, const std::filesystem::path& directory,
+                                                  int frames, cv::Size size, double unitsPerPixel) {
+    std::error_code ec;
+    std::filesystem::create_directories(directory, ec);
+    if (ec) throw BoothError(ErrorKind::Output, directory.string(), "cannot create the folder: " + ec.message());
+    std::vector<std::filesystem::path> out;
+    for (int i = 0; i < frames; ++i) {
+        const double yaw = frames > 1 ? -90.0 + 180.0 * i / (frames - 1) : 0.0;
+        char name[32];
+        std::snprintf(name, sizeof name, "turntable_%03d.png", i);
+        const std::filesystem::path path = directory / name;
+        writeFileAtomically(path, encodeImage(renderToon(model, yaw, size, unitsPerPixel), ".png"));
+        out.push_back(path);
+    }
+    return out;
+}
+
+}  // namespace avatarbooth::toon

@@ -1,0 +1,55 @@
+// Kitamura's two-view toon character, second half: contour correspondence, billboard rendering, turntable strip.
+#pragma once
+
+#include "toon/toon_regions.h"
+
+#include <filesystem>
+
+namespace avatarbooth::toon {
+
+// Corresponding outline points of one matched pair, as offsets (pixels) from each region's centroid: point i of
+// `a` corresponds to point i of `b`; the billboard's outline is interpolated segment by segment between them.
+struct ContourCorrespondence {
+    std::vector<cv::Point2d> a, b;
+};
+// Automatic correspondence: both outlines resampled to `points` points by arc length, b's offsets rotated so the
+// regions' principal axes align, then the cyclic start of b chosen that puts each point nearest its partner.
+ContourCorrespondence correspondContours(const Region& a, const Region& b, int points = 64);
+
+// Everything needed to draw the toon head at any yaw between the two views.
+struct ToonModel {
+    DrawingView viewA, viewB;  // viewA at theta 0 (front), viewB at theta 90 (side): the renderer interpolates
+    Regions regionsA, regionsB;
+    std::vector<PlacedPair> pairs;
+    std::vector<ContourCorrespondence> contours;  // one per pair
+    // The first `backdropPairs` pairs are drawn first whatever their depth (toonFromPhotos: the whole head's
+    // silhouette, so regions left unmatched leave no holes).
+    std::size_t backdropPairs = 0;
+};
+// Splits both drawings (regions under `minRegionArea` pixels join their neighbours), matches A's regions to B's, places every matched pair and corresponds its outlines.
+ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const DrawingView& viewA,
+                         const cv::Mat& drawingB, const cv::Mat& maskB, const DrawingView& viewB,
+                         const cv::Mat& outlineA = cv::Mat(), const cv::Mat& outlineB = cv::Mat(),
+                         int minRegionArea = 30);
+
+// Renders the billboards orthographically at `yawDeg` in [-90, 90] (0 = front, 90 = view B's side, negative =
+// the other side, drawn mirrored), far regions first, each filled with its colour and outlined dark.
+// `unitsPerPixel` is the render's scale in character units; the origin lands on the image centre.
+cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel,
+                   int outlineWidth = 2);
+
+// Builds a toon model from a front photo and a side photo with their head masks. The side photo may face either
+// way: `sideNoseImageRight` (SideAnalysis::noseImageRight) says which, and such a photo is mirrored so it looks at
+// the character's left side (theta 90). Both are cropped to their masks and scaled to `headHeightPx` pixels of
+// mask height, so heights agree; the origin is the front mask's box centre and the side mask's box centre.
+// Throws BoothError(NoFace) when a mask is empty.
+ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, const cv::Mat& sideBgr,
+                         const cv::Mat& sideMask, bool sideNoseImageRight, int colours = 6,
+                         int headHeightPx = 320);
+
+// Writes `frames` PNGs (turntable_000.png …) sweeping the yaw from -90 to 90 degrees into `directory`
+// (created if missing), each file atomically; returns the paths.
+std::vector<std::filesystem::path> writeTurntable(const ToonModel& model, const std::filesystem::path& directory,
+                                                  int frames, cv::Size size, double unitsPerPixel);
+
+}  // namespace avatarbooth::toon
