@@ -14,6 +14,7 @@ packages=(
   libcli11-dev libspdlog-dev libtomlplusplus-dev libsystemd-dev libgpiod-dev libcamera-dev
   libfreetype-dev fonts-dejavu-core fonts-vlgothic
   libgtest-dev libgmock-dev libbenchmark-dev
+  systemd device-tree-compiler
   nodejs npm
 )
 missing=()

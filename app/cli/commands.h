@@ -13,6 +13,10 @@ void registerMakeBaseHeadCommand(CLI::App& app);
 void registerMakeVisitorCommand(CLI::App& app);
 // `avatarbooth run`: the kiosk (real devices when present, else the simulated booth).
 void registerRunCommand(CLI::App& app);
+// `avatarbooth check`: the hardware and set-up self-test (exit code non-zero when something needed is missing).
+void registerCheckCommand(CLI::App& app);
+// `avatarbooth retention`: applies the sessions' retention rules once (the timer's job when the booth is stopped).
+void registerRetentionCommand(CLI::App& app);
 // `avatarbooth bench`: per-stage fit times on one photo pair.
 void registerBenchCommand(CLI::App& app);
 // `avatarbooth toon`: a front + side photo pair to Kitamura's two-view toon head, as a turntable strip of PNGs.

@@ -21,9 +21,14 @@ int main(int argc, char** argv) {
     avatarbooth::registerToonCommand(app);
     avatarbooth::registerMakeVisitorCommand(app);
     avatarbooth::registerBenchCommand(app);
+    avatarbooth::registerCheckCommand(app);
+    avatarbooth::registerRetentionCommand(app);
     app.parse_complete_callback([&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::warn); });
     try {
         app.parse(argc, argv);
+    } catch (const CLI::RuntimeError& e) {
+        // A command that has reported its own failure (e.g. `check`) and exits with the code it chose.
+        return e.get_exit_code();
     } catch (const CLI::ParseError& e) {
         // --help and --version are "errors" with code 0; every real usage error exits with 2.
         const int code = app.exit(e);

@@ -61,6 +61,7 @@ public:
     Chip& operator=(const Chip&) = delete;
 
     const std::string& name() const { return name_; }
+    gpiod_chip* raw() const { return chip_; }
 
     // The line at `offset`, or a Device error naming the chip's range.
     gpiod_line* line(unsigned offset, const std::string& label) {
@@ -258,6 +259,27 @@ bool gpiodChipAvailable(const std::string& chip, std::string* why) {
     }
     if (why != nullptr) *why = "GPIO chip \"" + chip + "\": " + openFailure(errno ? errno : ENOENT);
     return false;
+}
+
+std::vector<GpioLineStatus> gpiodLineStatus(const std::string& chip, const std::vector<unsigned>& offsets,
+                                            std::string* chipName) {
+    Chip c(chip);  // throws Device naming the chip and why
+    if (chipName != nullptr) *chipName = c.name();
+    std::vector<GpioLineStatus> out;
+    for (const unsigned offset : offsets) {
+        GpioLineStatus st;
+        st.offset = offset;
+        // gpiod_chip_get_line only looks the line up: nothing is requested, so a running booth is not disturbed.
+        if (gpiod_line* l = gpiod_chip_get_line(c.raw(), offset)) {
+            st.exists = true;
+            gpiod_line_update(l);
+            st.used = gpiod_line_is_used(l);
+            if (const char* user = gpiod_line_consumer(l)) st.consumer = user;
+            if (const char* name = gpiod_line_name(l)) st.name = name;
+        }
+        out.push_back(st);
+    }
+    return out;
 }
 
 }  // namespace avatarbooth

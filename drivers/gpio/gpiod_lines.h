@@ -36,4 +36,18 @@ std::unique_ptr<RawOutputLines> openGpiodOutputLines(const std::string& chip,
 // that exist.
 bool gpiodChipAvailable(const std::string& chip, std::string* why = nullptr);
 
+// What `avatarbooth check` says about one configured line, found without requesting it.
+struct GpioLineStatus {
+    unsigned offset = 0;
+    bool exists = false;   // the chip has a line at this offset
+    bool used = false;     // requested by someone (the kernel or a process) right now
+    std::string consumer;  // who, when used
+    std::string name;      // the line's name from the device tree ("GPIO17"), when it has one
+};
+
+// The state of `offsets` on `chip` (label, name, path or number). Throws BoothError(Device) when the chip cannot be
+// opened; `chipName` gets "gpiochip0 [pinctrl-bcm2711]".
+std::vector<GpioLineStatus> gpiodLineStatus(const std::string& chip, const std::vector<unsigned>& offsets,
+                                            std::string* chipName = nullptr);
+
 }  // namespace avatarbooth

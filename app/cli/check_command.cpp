@@ -1,0 +1,313 @@
+// `avatarbooth check [--config FILE] [--json]`: the hardware and set-up self-test an operator runs first.
+//
+// One line per thing the booth needs: OK, WARN (works, but not as a booth would on real hardware: "auto" falls back
+// to a simulation) or FAIL (what the configuration asks for is missing). Nothing is taken: cameras are listed, GPIO
+// lines looked up but not requested, the screen probed without keeping it, so check can run next to a running
+// booth. The exit code is non-zero when anything FAILs (the code of the first failure's kind, see exit_codes.h).
+#include "cli/commands.h"
+#include "cli/exit_codes.h"
+
+#include "common/error.h"
+#include "config/booth_config.h"
+#include "drivers/camera/camera_factory.h"
+#include "drivers/display/kms_display.h"
+#include "drivers/gpio/gpiod_lines.h"
+#include "face/landmarks68.h"
+#include "screens/strings.h"
+
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace avatarbooth {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kInstalledConfig = "/etc/avatarbooth/booth.toml";
+
+enum class Status { Ok, Warn, Fail };
+
+struct CheckLine {
+    std::string what;  // "config", "camera", "gpio", "display", "landmarks", "strings", "sessions"
+    Status status = Status::Ok;
+    std::string message;
+    ErrorKind kind = ErrorKind::Internal;  // for the exit code of a FAIL
+};
+
+const char* statusName(Status s) {
+    switch (s) {
+        case Status::Ok: return "OK";
+        case Status::Warn: return "WARN";
+        case Status::Fail: return "FAIL";
+    }
+    return "?";
+}
+
+class Report {
+public:
+    void ok(const std::string& what, const std::string& message) {
+        lines_.push_back({what, Status::Ok, message, ErrorKind::Internal});
+    }
+    void warn(const std::string& what, const std::string& message) {
+        lines_.push_back({what, Status::Warn, message, ErrorKind::Internal});
+    }
+    void fail(const std::string& what, const std::string& message, ErrorKind kind) {
+        lines_.push_back({what, Status::Fail, message, kind});
+    }
+    const std::vector<CheckLine>& lines() const { return lines_; }
+
+private:
+    std::vector<CheckLine> lines_;
+};
+
+// The configuration: the file given, else the installed one, else the built-in defaults. An invalid file FAILs
+// and the other checks go on with the defaults, so one run shows everything that is wrong.
+BoothConfig checkConfig(const std::string& given, Report& report) {
+    const fs::path file = !given.empty() ? fs::path(given) : fs::exists(kInstalledConfig) ? fs::path(kInstalledConfig) : fs::path();
+    if (file.empty()) {
+        report.warn("config", std::string("no --config and no ") + kInstalledConfig + ": the built-in defaults apply");
+        return BoothConfig{};
+    }
+    try {
+        BoothConfig config = loadBoothConfig(file);
+        report.ok("config", file.string() + " is valid");
+        return config;
+    } catch (const BoothError& e) {
+        report.fail("config", e.what(), ErrorKind::BadConfig);
+    }
+    return BoothConfig{};
+}
+
+void checkCameras(const CameraSettings& settings, Report& report) {
+    const std::vector<CameraListEntry> cameras = listCameras();
+    for (const auto& c : cameras) {
+        const std::string line = c.backend + " " + c.device + ": " + c.name + "; " + c.formats;
+        if (c.usable) report.ok("camera", line);
+        else report.warn("camera", line + " (not usable)");
+    }
+    const bool anyUsable = std::any_of(cameras.begin(), cameras.end(), [](const auto& c) { return c.usable; });
+    if (settings.backend == "sim") {
+        if (!settings.simFolder.empty() && !fs::is_directory(settings.simFolder))
+            report.fail("camera", "sim: camera.sim_folder " + settings.simFolder + " is not a folder", ErrorKind::BadConfig);
+        else
+            report.ok("camera", "sim: the simulated camera (" +
+                                    (settings.simFolder.empty() ? std::string("the synthetic visitor") : settings.simFolder) + ")" +
+                                    (cameras.empty() ? "; no V4L2 or libcamera camera found" : ""));
+        return;
+    }
+    if (settings.backend == "auto") {
+        if (!anyUsable) report.warn("camera", "none found: the booth would run the simulated camera");
+        return;
+    }
+    // An explicit backend: a camera of that kind (and the configured device, when one is named) must be there.
+    bool found = false;
+    for (const auto& c : cameras)
+        if (c.backend == settings.backend && c.usable && (settings.device.empty() || c.device == settings.device))
+            found = true;
+    if (found) return;
+    report.fail("camera",
+                settings.backend + (settings.device.empty() ? std::string(": none found") : ": " + settings.device + " not found") +
+                    " (camera.backend = \"" + settings.backend + "\")",
+                ErrorKind::Device);
+}
+
+void checkGpio(const GpioSettings& settings, Report& report) {
+    if (settings.backend == "sim") {
+        report.ok("gpio", "sim: scripted buttons" + (settings.timeline.empty() ? std::string() : " from " + settings.timeline) +
+                              " and keyboard keys");
+        return;
+    }
+    std::vector<unsigned> offsets;
+    std::vector<std::string> labels;
+    for (const auto& b : settings.buttons) {
+        offsets.push_back(b.offset);
+        labels.push_back(b.name + " button");
+    }
+    for (const auto& l : settings.lamps) {
+        offsets.push_back(l.offset);
+        labels.push_back(l.name + " lamp");
+    }
+    std::string chipName;
+    std::vector<GpioLineStatus> lines;
+    try {
+        lines = gpiodLineStatus(settings.chip, offsets, &chipName);
+    } catch (const BoothError& e) {
+        // The error already lists the chips that exist.
+        if (settings.backend == "auto") report.warn("gpio", std::string(e.what()) + ": the booth would run simulated buttons");
+        else report.fail("gpio", e.what(), ErrorKind::Device);
+        return;
+    }
+    report.ok("gpio", "chip " + chipName);
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+        const GpioLineStatus& s = lines[i];
+        const std::string line = labels[i] + ": line " + std::to_string(s.offset) + (s.name.empty() ? "" : " (" + s.name + ")");
+        if (!s.exists) report.fail("gpio", line + " does not exist on " + chipName, ErrorKind::Device);
+        else if (s.used && s.consumer == settings.consumer)
+            report.warn("gpio", line + " is in use by \"" + s.consumer + "\" (is the booth running?)");
+        else if (s.used)
+            report.fail("gpio", line + " is in use by \"" + (s.consumer.empty() ? std::string("the kernel") : s.consumer) + "\"",
+                        ErrorKind::Device);
+        else report.ok("gpio", line + " is free");
+    }
+}
+
+// The DRM connectors sysfs shows ("card1-HDMI-A-1 connected, card1-HDMI-A-2 disconnected"), without opening a card.
+std::string drmConnectors() {
+    std::string out;
+    std::error_code ec;
+    std::vector<std::string> entries;
+    for (const auto& e : fs::directory_iterator("/sys/class/drm", ec)) {
+        const std::string name = e.path().filename().string();
+        std::ifstream status(e.path() / "status");
+        std::string state;
+        if (name.rfind("card", 0) == 0 && status >> state) entries.push_back(name + " " + state);
+    }
+    std::sort(entries.begin(), entries.end());
+    for (const auto& e : entries) out += (out.empty() ? "" : ", ") + e;
+    return out.empty() ? "none found" : out;
+}
+
+void checkDisplay(const DisplaySettings& settings, Report& report) {
+    if (settings.backend != "headless") report.ok("display", "DRM connectors: " + drmConnectors());
+    if (settings.backend == "headless") {
+        report.ok("display", "headless " + std::to_string(settings.width) + "x" + std::to_string(settings.height) + " (no screen)");
+        return;
+    }
+    if (settings.backend == "window") {
+        const char* d = std::getenv("DISPLAY");
+        if (d && *d) report.ok("display", std::string("window on X display ") + d);
+        else report.fail("display", "window: $DISPLAY is not set", ErrorKind::Device);
+        return;
+    }
+    std::string why;
+    if (kmsScreenAvailable(settings.drmDevice, settings.connector, &why)) {
+        report.ok("display", "kms: a connected screen" + (settings.drmDevice.empty() ? std::string() : " on " + settings.drmDevice) +
+                                 (settings.connector.empty() ? std::string() : " at " + settings.connector));
+        return;
+    }
+    if (settings.backend == "auto") report.warn("display", "no connected screen found (" + why + "): the booth would run headless");
+    else report.fail("display", "kms: " + why, ErrorKind::Device);
+}
+
+void checkLandmarkModel(const fs::path& model, Report& report) {
+    std::error_code ec;
+    if (!fs::is_regular_file(model, ec)) {
+        report.fail("landmarks", model.string() + " not found (Debian: libdlib-data; [fit] landmark_model)", ErrorKind::BadConfig);
+        return;
+    }
+    const auto size = fs::file_size(model, ec);
+    try {
+        LandmarkDetector detector(model);  // the real load: a truncated or foreign file fails here, not at the first visitor
+        report.ok("landmarks", model.string() + " loads (" + std::to_string(size / (1024 * 1024)) + " MB)");
+    } catch (const std::exception& e) {
+        report.fail("landmarks", std::string("cannot load: ") + e.what(), ErrorKind::BadConfig);
+    }
+}
+
+void checkStrings(const fs::path& configured, Report& report) {
+    try {
+        const fs::path file = configured.empty() ? StringTable::defaultFile() : configured;
+        StringTable::load(file);
+        report.ok("strings", file.string());
+    } catch (const BoothError& e) {
+        report.fail("strings", e.what(), ErrorKind::BadConfig);
+    }
+}
+
+// The sessions directory: writable by this user (tried with a real file) and the free space on its file system.
+void checkSessions(const fs::path& dir, Report& report) {
+    std::error_code ec;
+    fs::path existing = dir;
+    while (!existing.empty() && !fs::exists(existing, ec)) existing = existing.parent_path();
+    if (existing.empty() || !fs::is_directory(existing, ec)) {
+        report.fail("sessions", dir.string() + ": no existing parent folder", ErrorKind::Output);
+        return;
+    }
+    bool writable = false;
+    if (existing == dir) {
+        const fs::path probe = dir / (".check-" + std::to_string(::getpid()));
+        writable = static_cast<bool>(std::ofstream(probe) << "x");
+        fs::remove(probe, ec);
+    } else {
+        writable = ::access(existing.c_str(), W_OK | X_OK) == 0;
+    }
+    if (!writable) {
+        report.fail("sessions", dir.string() + " is not writable for this user (" + existing.string() + ")", ErrorKind::Output);
+        return;
+    }
+    const fs::space_info space = fs::space(existing, ec);
+    const double freeMb = ec ? -1.0 : static_cast<double>(space.available) / (1024.0 * 1024.0);
+    // A session is a few MB (photos, avatar, previews): below 100 MB the booth stops keeping sessions soon.
+    const std::string where = dir.string() + (existing == dir ? std::string() : " (will be created)");
+    const std::string freeText = ec ? std::string("free space unknown") : std::to_string(static_cast<long long>(freeMb)) + " MB free";
+    if (!ec && freeMb < 100.0) report.fail("sessions", where + ": only " + freeText, ErrorKind::Output);
+    else if (!ec && freeMb < 1024.0) report.warn("sessions", where + ": writable, " + freeText + " (less than 1 GB)");
+    else report.ok("sessions", where + ": writable, " + freeText);
+}
+
+}  // namespace
+
+void registerCheckCommand(CLI::App& app) {
+    auto* cmd = app.add_subcommand("check", "Self-test: cameras, GPIO lines, screen, landmark model, config, data folder");
+    struct Options {
+        std::string config;
+        bool json = false;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("--config", o->config,
+                    std::string("Configuration file to check (default: ") + kInstalledConfig + " when it exists)");
+    cmd->add_flag("--json", o->json, "Print the results as JSON (for scripts)");
+    cmd->callback([o] {
+        Report report;
+        const BoothConfig config = checkConfig(o->config, report);
+        checkCameras(config.camera, report);
+        checkGpio(config.buttons, report);
+        checkDisplay(config.display, report);
+        checkLandmarkModel(config.fit.settings.landmarkModel, report);
+        checkStrings(config.screen.stringsFile, report);
+        checkSessions(config.sessions.directory, report);
+
+        std::optional<ErrorKind> firstFailure;
+        int fails = 0, warns = 0;
+        for (const auto& l : report.lines()) {
+            if (l.status == Status::Fail) {
+                ++fails;
+                if (!firstFailure) firstFailure = l.kind;
+            }
+            if (l.status == Status::Warn) ++warns;
+        }
+        if (o->json) {
+            nlohmann::json out;
+            out["ok"] = fails == 0;
+            out["failures"] = fails;
+            out["warnings"] = warns;
+            out["checks"] = nlohmann::json::array();
+            for (const auto& l : report.lines())
+                out["checks"].push_back({{"check", l.what}, {"status", statusName(l.status)}, {"message", l.message}});
+            std::cout << out.dump(2) << "\n";
+        } else {
+            for (const auto& l : report.lines()) {
+                std::string status = statusName(l.status), what = l.what;
+                status.resize(5, ' ');
+                what.resize(10, ' ');
+                std::cout << status << what << l.message << "\n";
+            }
+            std::cout << (fails ? "check: " + std::to_string(fails) + " failure(s), " : std::string("check: ready, "))
+                      << warns << " warning(s)\n";
+        }
+        if (firstFailure) throw CLI::RuntimeError(exitCodeFor(*firstFailure));
+    });
+}
+
+}  // namespace avatarbooth

@@ -1,0 +1,152 @@
+// `avatarbooth check` as an operator runs it: a simulated booth's config passes, a config asking for hardware this
+// machine lacks FAILs with a non-zero exit code, a broken config FAILs naming file, line and key, --json parses.
+#include "test_paths.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <fstream>
+
+namespace fs = std::filesystem;
+using namespace avatarbooth::test;
+
+namespace {
+
+struct CommandResult {
+    int exitCode = -1;
+    std::string out;  // stdout only (the JSON), stderr goes to err
+    std::string err;
+};
+
+CommandResult run(const std::string& args, const fs::path& dir) {
+    CommandResult r;
+    const fs::path errFile = dir / "stderr.txt";
+    const std::string cmd = binary().string() + " " + args + " 2>" + errFile.string();
+    FILE* pipe = popen(cmd.c_str(), "r");
+    std::array<char, 4096> buf{};
+    while (fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
+    const int status = pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::ifstream in(errFile);
+    r.err.assign(std::istreambuf_iterator<char>(in), {});
+    return r;
+}
+
+// The statuses of one check (e.g. "camera") in a --json report.
+std::vector<std::string> statusesOf(const nlohmann::json& report, const std::string& check) {
+    std::vector<std::string> out;
+    for (const auto& c : report.at("checks"))
+        if (c.at("check") == check) out.push_back(c.at("status").get<std::string>());
+    return out;
+}
+
+std::string messagesOf(const nlohmann::json& report, const std::string& check) {
+    std::string out;
+    for (const auto& c : report.at("checks"))
+        if (c.at("check") == check) out += c.at("message").get<std::string>() + "\n";
+    return out;
+}
+
+}  // namespace
+
+TEST(CheckCli, SimulatedBoothIsReady) {
+    const fs::path dir = scratchDir("check_sim");
+    const fs::path config = dir / "booth.toml";
+    std::ofstream(config) << "[camera]\nbackend = \"sim\"\n[buttons]\nbackend = \"sim\"\n[display]\nbackend = \"headless\"\n"
+                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
+    fs::create_directories(dir / "sessions");
+    const CommandResult text = run("check --config " + config.string(), dir);
+    EXPECT_EQ(text.exitCode, 0) << text.out << text.err;
+    EXPECT_NE(text.out.find("OK   config    " + config.string() + " is valid"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("check: ready"), std::string::npos) << text.out;
+
+    const CommandResult json = run("check --json --config " + config.string(), dir);
+    ASSERT_EQ(json.exitCode, 0) << json.out << json.err;
+    const nlohmann::json report = nlohmann::json::parse(json.out);
+    EXPECT_TRUE(report.at("ok").get<bool>());
+    EXPECT_EQ(report.at("failures").get<int>(), 0);
+    for (const char* check : {"config", "gpio", "display", "landmarks", "strings", "sessions"}) {
+        const auto s = statusesOf(report, check);
+        ASSERT_FALSE(s.empty()) << check;
+        EXPECT_EQ(s.back(), "OK") << check << ": " << messagesOf(report, check);
+    }
+    EXPECT_NE(messagesOf(report, "sessions").find("MB free"), std::string::npos);
+    EXPECT_NE(messagesOf(report, "landmarks").find("loads"), std::string::npos);
+    // The sim camera is OK whatever real cameras this machine has.
+    EXPECT_EQ(statusesOf(report, "camera").back(), "OK");
+}
+
+TEST(CheckCli, MissingHardwareTheConfigAsksForFails) {
+    const fs::path dir = scratchDir("check_missing");
+    const fs::path config = dir / "booth.toml";
+    // Names no machine has: a V4L2 node, a GPIO chip, a DRM card.
+    std::ofstream(config) << "[camera]\nbackend = \"v4l2\"\ndevice = \"/dev/video-avatarbooth-none\"\n"
+                          << "[buttons]\nbackend = \"gpiod\"\nchip = \"avatarbooth-no-such-chip\"\n"
+                          << "[display]\nbackend = \"kms\"\ndrm_device = \"/dev/dri/card-avatarbooth-none\"\n"
+                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
+    const CommandResult r = run("check --json --config " + config.string(), dir);
+    EXPECT_EQ(r.exitCode, 8) << r.out << r.err;  // kExitDevice
+    const nlohmann::json report = nlohmann::json::parse(r.out);
+    EXPECT_FALSE(report.at("ok").get<bool>());
+    EXPECT_EQ(statusesOf(report, "camera").back(), "FAIL") << messagesOf(report, "camera");
+    EXPECT_NE(messagesOf(report, "camera").find("/dev/video-avatarbooth-none not found"), std::string::npos);
+    EXPECT_EQ(statusesOf(report, "gpio").back(), "FAIL") << messagesOf(report, "gpio");
+    EXPECT_NE(messagesOf(report, "gpio").find("avatarbooth-no-such-chip"), std::string::npos);
+    EXPECT_EQ(statusesOf(report, "display").back(), "FAIL") << messagesOf(report, "display");
+    // A sessions folder that does not exist yet but can be made is fine.
+    EXPECT_EQ(statusesOf(report, "sessions").back(), "OK") << messagesOf(report, "sessions");
+    EXPECT_NE(messagesOf(report, "sessions").find("will be created"), std::string::npos);
+}
+
+TEST(CheckCli, AutoWithoutHardwareWarnsAndSaysNoneFound) {
+    const fs::path dir = scratchDir("check_auto");
+    const fs::path config = dir / "booth.toml";
+    std::ofstream(config) << "[buttons]\nchip = \"avatarbooth-no-such-chip\"\n"
+                          << "[display]\ndrm_device = \"/dev/dri/card-avatarbooth-none\"\n"
+                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
+    const CommandResult r = run("check --json --config " + config.string(), dir);
+    const nlohmann::json report = nlohmann::json::parse(r.out);
+    // "auto" falls back to the simulation: a warning, not a failure.
+    EXPECT_EQ(statusesOf(report, "gpio").back(), "WARN") << messagesOf(report, "gpio");
+    EXPECT_NE(messagesOf(report, "gpio").find("simulated buttons"), std::string::npos);
+    EXPECT_EQ(statusesOf(report, "display").back(), "WARN") << messagesOf(report, "display");
+    EXPECT_NE(messagesOf(report, "display").find("headless"), std::string::npos);
+    EXPECT_EQ(r.exitCode, report.at("failures").get<int>() == 0 ? 0 : 8) << r.out;
+}
+
+TEST(CheckCli, BrokenConfigFailsNamingFileLineAndKey) {
+    const fs::path dir = scratchDir("check_broken");
+    const fs::path config = dir / "booth.toml";
+    std::ofstream(config) << "[camera]\nbackend = \"sim\"\n\n[sessions]\nphoto_retention_hourz = 3\n";
+    const CommandResult r = run("check --config " + config.string(), dir);
+    EXPECT_EQ(r.exitCode, 6) << r.out << r.err;  // kExitBadConfig
+    EXPECT_NE(r.out.find("FAIL config    " + config.string() + ":5"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("photo_retention_hourz"), std::string::npos) << r.out;
+    // The other checks still ran (with the defaults).
+    EXPECT_NE(r.out.find("landmarks"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("sessions"), std::string::npos) << r.out;
+}
+
+TEST(CheckCli, MissingLandmarkModelFails) {
+    const fs::path dir = scratchDir("check_model");
+    const fs::path config = dir / "booth.toml";
+    std::ofstream(config) << "[fit]\nlandmark_model = \"" << (dir / "none.dat").string() << "\"\n"
+                          << "[camera]\nbackend = \"sim\"\n[buttons]\nbackend = \"sim\"\n[display]\nbackend = \"headless\"\n"
+                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
+    // A file that exists but is no model: found, and then refused when loaded.
+    const fs::path junk = dir / "junk.dat";
+    std::ofstream(junk) << "not a dlib model";
+    CommandResult r = run("check --config " + config.string(), dir);
+    EXPECT_EQ(r.exitCode, 6) << r.out;
+    EXPECT_NE(r.out.find("FAIL landmarks " + (dir / "none.dat").string() + " not found"), std::string::npos) << r.out;
+
+    std::ofstream(config) << "[fit]\nlandmark_model = \"" << junk.string() << "\"\n"
+                          << "[camera]\nbackend = \"sim\"\n[buttons]\nbackend = \"sim\"\n[display]\nbackend = \"headless\"\n"
+                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
+    r = run("check --config " + config.string(), dir);
+    EXPECT_EQ(r.exitCode, 6) << r.out;
+    EXPECT_NE(r.out.find("FAIL landmarks cannot load"), std::string::npos) << r.out;
+}
