@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Runs the `kernel` tests: prepares (or reuses) the guest (setup.sh), boots Debian's stock kernel under
+# qemu-system-x86_64 (TCG: no KVM, no host modules) with the host's root shared read-only over 9p, and runs the
+# kernel_tests GoogleTest executable inside it against vivid, gpio-sim and vimc. Exit code: the tests'.
+# Usage: tests/kernel/run.sh KERNEL_TESTS_BINARY CACHE_DIR WORK_DIR [GTEST_FILTER] [TIMEOUT_S]
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+binary=$(readlink -f "${1:?usage: run.sh KERNEL_TESTS_BINARY CACHE_DIR WORK_DIR [GTEST_FILTER] [TIMEOUT_S]}")
+cache=${2:?cache dir}
+work=$(readlink -m "${3:?work dir}")
+filter=${4:-*}
+limit=${5:-600}
+
+start=$(date +%s)
+kdir=$("$here/setup.sh" "$cache")
+echo "kernel tests: guest kernel $(basename "$kdir") ready after $(( $(date +%s) - start )) s"
+
+# The work folder is shared read-write; the guest's /tmp is a tmpfs, so everything it writes goes here.
+rm -rf "$work"; mkdir -p "$work"
+cat > "$work/guest.sh" <<GUEST
+# Runs inside the guest (root, chrooted into the host's root; \$W = this folder, \$KMOD_ROOT = guest modules).
+echo "[guest] running $binary"
+"$binary" --gtest_filter='$filter' --gtest_color=no --gtest_output=xml:"\$W/kernel_tests.xml"
+GUEST
+accel="-accel tcg,thread=multi -cpu max"
+rc=0
+# -nic none: the tests need no network. panic=-1 and -no-reboot turn a guest crash into qemu exiting.
+timeout -k 10 "$limit" qemu-system-x86_64 $accel -m 1024 -smp "$(nproc)" -nographic -no-reboot -nic none \
+  -kernel "$kdir/vmlinuz" -initrd "$kdir/initrd.img" \
+  -append "console=ttyS0 loglevel=4 panic=-1 edd=off rdinit=/init avatarbooth_kernel_guest=1 wdir=$work kroot=$kdir/kroot gscript=$work/guest.sh" \
+  -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap \
+  -virtfs local,path="$work",mount_tag=work,security_model=none,multidevs=remap < /dev/null || rc=$?
+if [ "$rc" -ne 0 ]; then echo "kernel tests: qemu failed or timed out after ${limit} s (exit $rc)"; exit 1; fi
+[ -f "$work/rc" ] || { echo "kernel tests: the guest script never finished (no $work/rc)"; exit 1; }
+guest_rc=$(cat "$work/rc")
+echo "kernel tests: guest exit code $guest_rc, $(( $(date +%s) - start )) s in all"
+exit "$guest_rc"
