@@ -12,6 +12,10 @@
 # build/release/share/avatarbooth/strings.toml), so the built binary runs from any working directory.
 configure_file(${CMAKE_SOURCE_DIR}/app/assets/strings.toml ${CMAKE_BINARY_DIR}/share/avatarbooth/strings.toml COPYONLY)
 
+# `install` (and cpack's preinstall step) builds nothing: the package test runs cpack on a built tree, and a full
+# rebuild of every target there would take the CI's time.
+set(CMAKE_SKIP_INSTALL_ALL_DEPENDENCY TRUE)
+
 install(TARGETS avatarbooth RUNTIME DESTINATION bin)
 install(FILES ${CMAKE_SOURCE_DIR}/app/assets/strings.toml DESTINATION share/avatarbooth)
 # The config lives in /etc whatever the prefix: it is the operator's file (a dpkg conffile, kept on upgrade).
