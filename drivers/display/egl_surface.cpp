@@ -3,6 +3,7 @@
 #define MESA_EGL_NO_X11_HEADERS 1
 
 #include "drivers/display/egl_surface.h"
+#include "drivers/display/headless_egl.h"
 
 #include "common/error.h"
 
@@ -24,17 +25,6 @@ std::string eglFailure(std::string_view call) {
     return std::string(call) + " failed (EGL error " + hex + ")";
 }
 
-bool hasExtension(const char* list, std::string_view name) {
-    if (list == nullptr) return false;
-    std::string_view rest(list);
-    while (!rest.empty()) {
-        const auto end = rest.find(' ');
-        if (rest.substr(0, end) == name) return true;
-        if (end == std::string_view::npos) break;
-        rest.remove_prefix(end + 1);
-    }
-    return false;
-}
 
 }  // namespace
 
@@ -43,7 +33,7 @@ EglWindowSurface::EglWindowSurface(unsigned platform, void* nativeDisplay, int v
     const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     const auto getPlatformDisplay =
         reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-    if (!hasExtension(client, "EGL_EXT_platform_base") || getPlatformDisplay == nullptr)
+    if (!eglExtensionListHas(client, "EGL_EXT_platform_base") || getPlatformDisplay == nullptr)
         throw BoothError(ErrorKind::Device, who_, "EGL_EXT_platform_base (eglGetPlatformDisplayEXT) is not offered");
     const EGLDisplay display = getPlatformDisplay(static_cast<EGLenum>(platform), nativeDisplay, nullptr);
     if (display == EGL_NO_DISPLAY) throw BoothError(ErrorKind::Device, who_, eglFailure("eglGetPlatformDisplayEXT"));

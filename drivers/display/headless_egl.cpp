@@ -53,18 +53,6 @@ std::string failure(std::string_view call) {
     throw std::runtime_error("headless EGL display: " + failure(call));
 }
 
-// Whether a space-separated extension list names `name` (as a whole word).
-bool hasExtension(const char* list, std::string_view name) {
-    if (list == nullptr) return false;
-    std::string_view rest(list);
-    while (!rest.empty()) {
-        const auto end = rest.find(' ');
-        if (rest.substr(0, end) == name) return true;
-        if (end == std::string_view::npos) break;
-        rest.remove_prefix(end + 1);
-    }
-    return false;
-}
 
 // Any config that can render OpenGL ES 3: surface type 0 because we draw into framebuffer objects only (the
 // default, EGL_WINDOW_BIT, matches nothing on the surfaceless platform).
@@ -92,7 +80,7 @@ bool adoptDisplay(EGLDisplay display, std::string_view label, std::vector<std::s
         return false;
     }
     std::string problem;
-    if (!hasExtension(eglQueryString(display, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context")) {
+    if (!eglExtensionListHas(eglQueryString(display, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context")) {
         problem = "EGL_KHR_surfaceless_context is not offered";
     } else if (major == 1 && minor < 4) {
         problem = "EGL " + std::to_string(major) + "." + std::to_string(minor) + " is older than 1.4";
@@ -129,12 +117,12 @@ EGLDisplay openDisplay() {
     if (client == nullptr) fail("eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS) (EGL client extensions)");
     const auto getPlatformDisplay =
         reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-    if (!hasExtension(client, "EGL_EXT_platform_base") || getPlatformDisplay == nullptr)
+    if (!eglExtensionListHas(client, "EGL_EXT_platform_base") || getPlatformDisplay == nullptr)
         throw std::runtime_error(
             "headless EGL display: EGL_EXT_platform_base (eglGetPlatformDisplayEXT) is not offered by this EGL");
 
     std::vector<std::string> why;
-    if (hasExtension(client, "EGL_MESA_platform_surfaceless")) {
+    if (eglExtensionListHas(client, "EGL_MESA_platform_surfaceless")) {
         const EGLDisplay display = getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
         if (display == EGL_NO_DISPLAY)
             why.push_back(failure("eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA)"));
@@ -144,13 +132,13 @@ EGLDisplay openDisplay() {
         why.push_back("EGL_MESA_platform_surfaceless is not offered");
     }
 
-    const bool canEnumerate = hasExtension(client, "EGL_EXT_device_enumeration") ||
-                              hasExtension(client, "EGL_EXT_device_base");
+    const bool canEnumerate = eglExtensionListHas(client, "EGL_EXT_device_enumeration") ||
+                              eglExtensionListHas(client, "EGL_EXT_device_base");
     const auto queryDevices =
         reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
     const auto queryDeviceString =
         reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
-    if (!canEnumerate || !hasExtension(client, "EGL_EXT_platform_device") || queryDevices == nullptr) {
+    if (!canEnumerate || !eglExtensionListHas(client, "EGL_EXT_platform_device") || queryDevices == nullptr) {
         why.push_back("EGL_EXT_device_enumeration with EGL_EXT_platform_device is not offered");
     } else {
         EGLint count = 0;
@@ -165,7 +153,7 @@ EGLDisplay openDisplay() {
         }
         const auto isSoftware = [&](EGLDeviceEXT device) {
             return queryDeviceString != nullptr &&
-                   hasExtension(queryDeviceString(device, EGL_EXTENSIONS), "EGL_MESA_device_software");
+                   eglExtensionListHas(queryDeviceString(device, EGL_EXTENSIONS), "EGL_MESA_device_software");
         };
         std::stable_partition(devices.begin(), devices.end(), [&](EGLDeviceEXT d) { return !isSoftware(d); });
         for (std::size_t i = 0; i < devices.size(); ++i) {
@@ -245,6 +233,18 @@ void HeadlessEglContext::release() {
     if (eglGetCurrentContext() != static_cast<EGLContext>(context_)) return;
     if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT))
         fail("eglMakeCurrent(EGL_NO_CONTEXT)");
+}
+
+bool eglExtensionListHas(const char* list, std::string_view name) {
+    if (list == nullptr) return false;
+    std::string_view rest(list);
+    while (!rest.empty()) {
+        const auto end = rest.find(' ');
+        if (rest.substr(0, end) == name) return true;
+        if (end == std::string_view::npos) break;
+        rest.remove_prefix(end + 1);
+    }
+    return false;
 }
 
 }  // namespace avatarbooth

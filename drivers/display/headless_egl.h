@@ -8,6 +8,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 namespace avatarbooth {
 
@@ -38,5 +39,9 @@ private:
     void* context_ = nullptr;  // EGLContext
     std::string renderer_;
 };
+
+// Whether a space-separated EGL extension list (eglQueryString(..., EGL_EXTENSIONS)) names `name` as a whole word;
+// false for a null list. Shared by every EGL user in drivers/display.
+bool eglExtensionListHas(const char* list, std::string_view name);
 
 }  // namespace avatarbooth

@@ -1,6 +1,6 @@
 // `avatarbooth fit` run as a user runs it: the session folder, the glb under the Khronos validator, and every
 // kind of bad input answered with a clear error, its own exit code, and nothing half-written.
-#include "test_paths.h"
+#include "run_binary.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -17,28 +17,13 @@ using namespace avatarbooth::test;
 
 namespace {
 
-struct CommandResult {
-    int exitCode = -1;
-    std::string output;  // stdout and stderr
-};
-
-CommandResult run(const std::string& args) {
-    CommandResult r;
-    const std::string cmd = binary().string() + " " + args + " 2>&1";
-    FILE* pipe = popen(cmd.c_str(), "r");
-    std::array<char, 4096> buf{};
-    while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
 
 // One synthetic visitor per test process (rendering costs a second); ctest runs each test in its own process,
 // several at once, so the folder is the process's own.
 const fs::path& visitor() {
     static const fs::path dir = [] {
         const fs::path d = scratchDir("e2e_visitor_" + std::to_string(getpid())) / "visitor";
-        const CommandResult r = run("make-visitor --seed 2 -o " + d.string());
+        const CommandResult r = runAvatarbooth("make-visitor --seed 2 -o " + d.string());
         EXPECT_EQ(r.exitCode, 0) << r.output;
         return d;
     }();
@@ -68,7 +53,7 @@ void expectNoLeftovers(const fs::path& parent) {
 
 TEST(FitCli, WritesACompleteSessionFolderWithAValidGlb) {
     const fs::path out = scratchDir("e2e_fit") / "session";
-    const CommandResult r = run(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", out));
+    const CommandResult r = runAvatarbooth(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", out));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("avatar written to"), std::string::npos) << r.output;
     for (const char* f : {"avatar.glb", "front.jpg", "side.jpg", "landmarks.json", "fit.json", "front_overlay.jpg",
@@ -98,10 +83,10 @@ TEST(FitCli, WritesACompleteSessionFolderWithAValidGlb) {
 TEST(FitCli, RerunReplacesAnEarlierResultAndAFailedRunKeepsIt) {
     const fs::path dir = scratchDir("e2e_rerun");
     const fs::path out = dir / "session";
-    ASSERT_EQ(run(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", out)).exitCode, 0);
+    ASSERT_EQ(runAvatarbooth(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", out)).exitCode, 0);
     const std::string before = readBytes(out / "fit.json");
     writeBytes(dir / "empty.jpg", "");
-    const CommandResult r = run(fitArgs(dir / "empty.jpg", visitor() / "side.jpg", out));
+    const CommandResult r = runAvatarbooth(fitArgs(dir / "empty.jpg", visitor() / "side.jpg", out));
     EXPECT_EQ(r.exitCode, 3) << r.output;
     EXPECT_EQ(readBytes(out / "fit.json"), before) << "a failed run must leave the earlier result as it was";
     expectNoLeftovers(dir);
@@ -111,7 +96,7 @@ TEST(FitCli, RefusesToReplaceAFolderThatIsNotAnEarlierResult) {
     const fs::path dir = scratchDir("e2e_foreign");
     fs::create_directories(dir / "holiday");
     writeBytes(dir / "holiday" / "photo.jpg", "keep me");
-    const CommandResult r = run(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", dir / "holiday"));
+    const CommandResult r = runAvatarbooth(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", dir / "holiday"));
     EXPECT_EQ(r.exitCode, 7) << r.output;
     EXPECT_EQ(readBytes(dir / "holiday" / "photo.jpg"), "keep me");
 }
@@ -163,7 +148,7 @@ TEST_P(FitCliBadInput, ClearErrorOwnExitCodeNothingWritten) {
         cv::imwrite(side.string(), canvas);
     }
     const fs::path out = dir / "session";
-    const CommandResult r = run(fitArgs(front, side, out));
+    const CommandResult r = runAvatarbooth(fitArgs(front, side, out));
     EXPECT_EQ(r.exitCode, c.exitCode) << r.output;
     EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
     const fs::path named = (which == "side_is_front" || which == "side_other_framing") ? side : front;
@@ -184,12 +169,12 @@ INSTANTIATE_TEST_SUITE_P(
     [](const ::testing::TestParamInfo<BadInputCase>& p) { return std::string(p.param.name); });
 
 TEST(FitCli, HelpAndUsageErrors) {
-    const CommandResult help = run("--help");
+    const CommandResult help = runAvatarbooth("--help");
     EXPECT_EQ(help.exitCode, 0);
     EXPECT_NE(help.output.find("fit"), std::string::npos);
     EXPECT_NE(help.output.find("Exit codes"), std::string::npos);
-    EXPECT_EQ(run("fit --front x.jpg").exitCode, 2) << "missing --side and -o is a usage error";
-    const CommandResult kernel = run(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", scratchDir("e2e_kernel") / "o") + " --kernel cubic");
+    EXPECT_EQ(runAvatarbooth("fit --front x.jpg").exitCode, 2) << "missing --side and -o is a usage error";
+    const CommandResult kernel = runAvatarbooth(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", scratchDir("e2e_kernel") / "o") + " --kernel cubic");
     EXPECT_EQ(kernel.exitCode, 6) << kernel.output;
     EXPECT_NE(kernel.output.find("--kernel"), std::string::npos) << kernel.output;
 }
@@ -197,13 +182,13 @@ TEST(FitCli, HelpAndUsageErrors) {
 TEST(FitCli, ConfigFileGivesTheFitSettingsAndItsMistakesAreNamed) {
     const fs::path dir = scratchDir("e2e_fit_config");
     std::ofstream(dir / "booth.toml") << "[fit]\n\nrbf_kernel = \"cubic\"\n";
-    const CommandResult bad = run(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", dir / "session") + " --config " +
+    const CommandResult bad = runAvatarbooth(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", dir / "session") + " --config " +
                                   (dir / "booth.toml").string());
     EXPECT_EQ(bad.exitCode, 6) << bad.output;
     EXPECT_NE(bad.output.find("booth.toml:3: fit.rbf_kernel: \"cubic\" is not one of"), std::string::npos) << bad.output;
     EXPECT_FALSE(fs::exists(dir / "session"));
     std::ofstream(dir / "booth.toml") << "[fit]\nrbf_kernel = \"tps\"\n";
-    const CommandResult good = run(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", dir / "session") +
+    const CommandResult good = runAvatarbooth(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", dir / "session") +
                                    " --config " + (dir / "booth.toml").string());
     ASSERT_EQ(good.exitCode, 0) << good.output;
     std::ifstream report(dir / "session" / "fit.json");

@@ -1,6 +1,6 @@
 // The simulated booth end to end: `avatarbooth run` with the sim camera, sim buttons, a headless display and the
 // simulated visitor runs one whole session, keeps it under a code, and writes a screenshot of every screen.
-#include "test_paths.h"
+#include "run_binary.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -17,21 +17,6 @@ using namespace avatarbooth::test;
 
 namespace {
 
-struct CommandResult {
-    int exitCode = -1;
-    std::string output;
-};
-
-CommandResult run(const std::string& args) {
-    CommandResult r;
-    const std::string cmd = binary().string() + " " + args + " 2>&1";
-    FILE* pipe = popen(cmd.c_str(), "r");
-    std::array<char, 4096> buf{};
-    while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
 
 // Share of the pixels in the middle of the picture that are skin or hair coloured (red over blue), where the
 // booth's background is a dark blue.
@@ -53,7 +38,7 @@ TEST(KioskSim, OneScriptedSessionEndToEnd) {
     const fs::path config = dir / "booth.toml";
     std::ofstream(config) << "[camera]\nbackend = \"sim\"\n[buttons]\nbackend = \"sim\"\n[display]\nbackend = \"headless\"\n"
                           << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
-    const CommandResult r = run("run --config " + config.string() + " --sessions 1 --screenshots " + (dir / "screens").string());
+    const CommandResult r = runAvatarbooth("run --config " + config.string() + " --sessions 1 --screenshots " + (dir / "screens").string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
 
     // Kept under the code the thanks screen showed, complete, readable only by the booth's user.

@@ -1,7 +1,7 @@
 // Retention as the installed booth applies it: `avatarbooth retention` (what avatarbooth-retention.timer runs) with
 // the ages from a config file deletes the photos of sessions kept longer ago than photo_retention_hours and whole
 // sessions older than session_retention_days, and leaves newer sessions and a fit in progress alone.
-#include "test_paths.h"
+#include "run_binary.h"
 
 #include <gtest/gtest.h>
 
@@ -16,20 +16,6 @@ using namespace avatarbooth::test;
 
 namespace {
 
-struct CommandResult {
-    int exitCode = -1;
-    std::string output;
-};
-
-CommandResult run(const std::string& args) {
-    CommandResult r;
-    FILE* pipe = popen((binary().string() + " " + args + " 2>&1").c_str(), "r");
-    std::array<char, 4096> buf{};
-    while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
 
 // A kept session as SessionStore::keep leaves it, kept `age` ago.
 void makeSession(const fs::path& sessions, const std::string& code, std::chrono::seconds age) {
@@ -57,7 +43,7 @@ TEST(RetentionCli, DeletesPhotosFirstThenWholeSessionsByTheConfiguredAges) {
     fs::create_directories(sessions / ".pending" / "fit-in-progress");
     std::ofstream(sessions / ".pending" / "fit-in-progress" / "front.jpg") << "a visitor at the booth now";
 
-    const CommandResult r = run("retention --config " + config.string());
+    const CommandResult r = runAvatarbooth("retention --config " + config.string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("deleted 3 photo file(s) and 1 session(s)"), std::string::npos) << r.output;
 
@@ -72,6 +58,6 @@ TEST(RetentionCli, DeletesPhotosFirstThenWholeSessionsByTheConfiguredAges) {
         EXPECT_NE(e.path().filename().string().rfind(".trash-", 0), 0u) << e.path();
 
     // Run again: nothing more to do.
-    const CommandResult again = run("retention --config " + config.string());
+    const CommandResult again = runAvatarbooth("retention --config " + config.string());
     EXPECT_NE(again.output.find("deleted 0 photo file(s) and 0 session(s)"), std::string::npos) << again.output;
 }
