@@ -1,13 +1,11 @@
 // `avatarbooth check` as an operator runs it: a simulated booth's config passes, a config asking for hardware this
 // machine lacks FAILs with a non-zero exit code, a broken config FAILs naming file, line and key, --json parses.
+#include "run_binary.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <sys/wait.h>
-
-#include <array>
 #include <fstream>
 
 namespace fs = std::filesystem;
@@ -15,25 +13,8 @@ using namespace avatarbooth::test;
 
 namespace {
 
-struct CommandResult {
-    int exitCode = -1;
-    std::string out;  // stdout only (the JSON), stderr goes to err
-    std::string err;
-};
-
-CommandResult run(const std::string& args, const fs::path& dir) {
-    CommandResult r;
-    const fs::path errFile = dir / "stderr.txt";
-    const std::string cmd = binary().string() + " " + args + " 2>" + errFile.string();
-    FILE* pipe = popen(cmd.c_str(), "r");
-    std::array<char, 4096> buf{};
-    while (fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(errFile);
-    r.err.assign(std::istreambuf_iterator<char>(in), {});
-    return r;
-}
+// stdout only (the JSON); stderr kept apart.
+CommandResult run(const std::string& args, const fs::path& dir) { return runAvatarboothSplit(args, dir); }
 
 // The statuses of one check (e.g. "camera") in a --json report.
 std::vector<std::string> statusesOf(const nlohmann::json& report, const std::string& check) {
@@ -59,13 +40,13 @@ TEST(CheckCli, SimulatedBoothIsReady) {
                           << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
     fs::create_directories(dir / "sessions");
     const CommandResult text = run("check --config " + config.string(), dir);
-    EXPECT_EQ(text.exitCode, 0) << text.out << text.err;
-    EXPECT_NE(text.out.find("OK   config    " + config.string() + " is valid"), std::string::npos) << text.out;
-    EXPECT_NE(text.out.find("check: ready"), std::string::npos) << text.out;
+    EXPECT_EQ(text.exitCode, 0) << text.output << text.errors;
+    EXPECT_NE(text.output.find("OK   config    " + config.string() + " is valid"), std::string::npos) << text.output;
+    EXPECT_NE(text.output.find("check: ready"), std::string::npos) << text.output;
 
     const CommandResult json = run("check --json --config " + config.string(), dir);
-    ASSERT_EQ(json.exitCode, 0) << json.out << json.err;
-    const nlohmann::json report = nlohmann::json::parse(json.out);
+    ASSERT_EQ(json.exitCode, 0) << json.output << json.errors;
+    const nlohmann::json report = nlohmann::json::parse(json.output);
     EXPECT_TRUE(report.at("ok").get<bool>());
     EXPECT_EQ(report.at("failures").get<int>(), 0);
     for (const char* check : {"config", "gpio", "display", "landmarks", "strings", "sessions"}) {
@@ -88,8 +69,8 @@ TEST(CheckCli, MissingHardwareTheConfigAsksForFails) {
                           << "[display]\nbackend = \"kms\"\ndrm_device = \"/dev/dri/card-avatarbooth-none\"\n"
                           << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
     const CommandResult r = run("check --json --config " + config.string(), dir);
-    EXPECT_EQ(r.exitCode, 8) << r.out << r.err;  // kExitDevice
-    const nlohmann::json report = nlohmann::json::parse(r.out);
+    EXPECT_EQ(r.exitCode, 8) << r.output << r.errors;  // kExitDevice
+    const nlohmann::json report = nlohmann::json::parse(r.output);
     EXPECT_FALSE(report.at("ok").get<bool>());
     EXPECT_EQ(statusesOf(report, "camera").back(), "FAIL") << messagesOf(report, "camera");
     EXPECT_NE(messagesOf(report, "camera").find("/dev/video-avatarbooth-none not found"), std::string::npos);
@@ -108,13 +89,13 @@ TEST(CheckCli, AutoWithoutHardwareWarnsAndSaysNoneFound) {
                           << "[display]\ndrm_device = \"/dev/dri/card-avatarbooth-none\"\n"
                           << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
     const CommandResult r = run("check --json --config " + config.string(), dir);
-    const nlohmann::json report = nlohmann::json::parse(r.out);
+    const nlohmann::json report = nlohmann::json::parse(r.output);
     // "auto" falls back to the simulation: a warning, not a failure.
     EXPECT_EQ(statusesOf(report, "gpio").back(), "WARN") << messagesOf(report, "gpio");
     EXPECT_NE(messagesOf(report, "gpio").find("simulated buttons"), std::string::npos);
     EXPECT_EQ(statusesOf(report, "display").back(), "WARN") << messagesOf(report, "display");
     EXPECT_NE(messagesOf(report, "display").find("headless"), std::string::npos);
-    EXPECT_EQ(r.exitCode, report.at("failures").get<int>() == 0 ? 0 : 8) << r.out;
+    EXPECT_EQ(r.exitCode, report.at("failures").get<int>() == 0 ? 0 : 8) << r.output;
 }
 
 TEST(CheckCli, BrokenConfigFailsNamingFileLineAndKey) {
@@ -122,12 +103,12 @@ TEST(CheckCli, BrokenConfigFailsNamingFileLineAndKey) {
     const fs::path config = dir / "booth.toml";
     std::ofstream(config) << "[camera]\nbackend = \"sim\"\n\n[sessions]\nphoto_retention_hourz = 3\n";
     const CommandResult r = run("check --config " + config.string(), dir);
-    EXPECT_EQ(r.exitCode, 6) << r.out << r.err;  // kExitBadConfig
-    EXPECT_NE(r.out.find("FAIL config    " + config.string() + ":5"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("photo_retention_hourz"), std::string::npos) << r.out;
+    EXPECT_EQ(r.exitCode, 6) << r.output << r.errors;  // kExitBadConfig
+    EXPECT_NE(r.output.find("FAIL config    " + config.string() + ":5"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("photo_retention_hourz"), std::string::npos) << r.output;
     // The other checks still ran (with the defaults).
-    EXPECT_NE(r.out.find("landmarks"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("sessions"), std::string::npos) << r.out;
+    EXPECT_NE(r.output.find("landmarks"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("sessions"), std::string::npos) << r.output;
 }
 
 TEST(CheckCli, MissingLandmarkModelFails) {
@@ -140,13 +121,13 @@ TEST(CheckCli, MissingLandmarkModelFails) {
     const fs::path junk = dir / "junk.dat";
     std::ofstream(junk) << "not a dlib model";
     CommandResult r = run("check --config " + config.string(), dir);
-    EXPECT_EQ(r.exitCode, 6) << r.out;
-    EXPECT_NE(r.out.find("FAIL landmarks " + (dir / "none.dat").string() + " not found"), std::string::npos) << r.out;
+    EXPECT_EQ(r.exitCode, 6) << r.output;
+    EXPECT_NE(r.output.find("FAIL landmarks " + (dir / "none.dat").string() + " not found"), std::string::npos) << r.output;
 
     std::ofstream(config) << "[fit]\nlandmark_model = \"" << junk.string() << "\"\n"
                           << "[camera]\nbackend = \"sim\"\n[buttons]\nbackend = \"sim\"\n[display]\nbackend = \"headless\"\n"
                           << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
     r = run("check --config " + config.string(), dir);
-    EXPECT_EQ(r.exitCode, 6) << r.out;
-    EXPECT_NE(r.out.find("FAIL landmarks cannot load"), std::string::npos) << r.out;
+    EXPECT_EQ(r.exitCode, 6) << r.output;
+    EXPECT_NE(r.output.find("FAIL landmarks cannot load"), std::string::npos) << r.output;
 }

@@ -7,13 +7,16 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 namespace avatarbooth::test {
 
 struct CommandResult {
     int exitCode = -1;
-    std::string output;  // stdout and stderr
+    std::string output;  // stdout, and stderr too unless it was kept apart
+    std::string errors;  // stderr, when kept apart (runAvatarboothSplit)
 };
 
 // `avatarbooth ARGS`, its exit code and everything it printed.
@@ -24,6 +27,16 @@ inline CommandResult runAvatarbooth(const std::string& args) {
     while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
     const int status = pclose(pipe);
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+// `avatarbooth ARGS` with stderr kept apart from stdout (for output a script parses, e.g. --json), through a file
+// in DIR.
+inline CommandResult runAvatarboothSplit(const std::string& args, const std::filesystem::path& dir) {
+    const std::filesystem::path errFile = dir / "stderr.txt";
+    CommandResult r = runAvatarbooth(args + " 2>" + errFile.string());
+    std::ifstream in(errFile);
+    r.errors.assign(std::istreambuf_iterator<char>(in), {});
     return r;
 }
 
