@@ -19,10 +19,10 @@ struct CommandResult {
     std::string errors;  // stderr, when kept apart (runAvatarboothSplit)
 };
 
-// `avatarbooth ARGS`, its exit code and everything it printed.
-inline CommandResult runAvatarbooth(const std::string& args) {
+// `avatarbooth ARGS REDIRECT` through the shell: its exit code and what reached stdout.
+inline CommandResult runWithRedirect(const std::string& args, const std::string& redirect) {
     CommandResult r;
-    FILE* pipe = popen((binary().string() + " " + args + " 2>&1").c_str(), "r");
+    FILE* pipe = popen((binary().string() + " " + args + " " + redirect).c_str(), "r");
     std::array<char, 4096> buf{};
     while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
     const int status = pclose(pipe);
@@ -30,11 +30,14 @@ inline CommandResult runAvatarbooth(const std::string& args) {
     return r;
 }
 
+// `avatarbooth ARGS`, its exit code and everything it printed.
+inline CommandResult runAvatarbooth(const std::string& args) { return runWithRedirect(args, "2>&1"); }
+
 // `avatarbooth ARGS` with stderr kept apart from stdout (for output a script parses, e.g. --json), through a file
 // in DIR.
 inline CommandResult runAvatarboothSplit(const std::string& args, const std::filesystem::path& dir) {
     const std::filesystem::path errFile = dir / "stderr.txt";
-    CommandResult r = runAvatarbooth(args + " 2>" + errFile.string());
+    CommandResult r = runWithRedirect(args, "2>" + errFile.string());
     std::ifstream in(errFile);
     r.errors.assign(std::istreambuf_iterator<char>(in), {});
     return r;
