@@ -2,17 +2,18 @@
 // stays inside this file).
 #include "config/booth_config.h"
 
-#include "config/config_schema.h"
-
 #include "common/error.h"
+#include "config/config_schema.h"
 
 #include <toml++/toml.h>
 
-#include <chrono>
-#include <cmath>
+#include <algorithm>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <set>
 #include <sstream>
+#include <vector>
 
 namespace avatarbooth {
 namespace {
