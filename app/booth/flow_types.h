@@ -4,7 +4,9 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -215,5 +217,8 @@ struct ScreenModel {
 const char* toString(ScreenId id);
 const char* toString(Hint hint);
 const char* toString(Button button);
+// The button toString names ("start", "retake", "service"); nothing for any other word. The one mapping from the
+// names in config files, key bindings and button events to Button.
+std::optional<Button> parseButton(std::string_view name);
 
 }  // namespace avatarbooth

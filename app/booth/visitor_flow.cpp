@@ -92,6 +92,12 @@ const char* toString(Button button) {
     return "?";
 }
 
+std::optional<Button> parseButton(std::string_view name) {
+    for (const Button b : {Button::Start, Button::Retake, Button::Service})
+        if (name == toString(b)) return b;
+    return std::nullopt;
+}
+
 VisitorFlow::VisitorFlow(BoothSettings settings, FlowTime start)
     : settings_(std::move(settings)), enteredAt_(start), lastSeen_(start), lastOperatorPress_(start) {
     std::vector<FlowCommand> ignored;

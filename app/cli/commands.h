@@ -17,6 +17,8 @@ void registerRunCommand(CLI::App& app);
 void registerCheckCommand(CLI::App& app);
 // `avatarbooth retention`: applies the sessions' retention rules once (the timer's job when the booth is stopped).
 void registerRetentionCommand(CLI::App& app);
+// `avatarbooth config`: prints the documented default configuration or its Markdown reference, or checks a file.
+void registerConfigCommand(CLI::App& app);
 // `avatarbooth bench`: per-stage fit times on one photo pair.
 void registerBenchCommand(CLI::App& app);
 // `avatarbooth toon`: a front + side photo pair to Kitamura's two-view toon head, as a turntable strip of PNGs.

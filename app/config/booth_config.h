@@ -2,8 +2,9 @@
 //
 // Every key has a default (the struct's own), so an empty file is a valid configuration. The file is read
 // strictly: an unknown table or key, a value of the wrong type or out of range is an error naming the file, the
-// line and the key (ErrorKind::BadConfig), so a typo never silently falls back to a default. The reference of every
-// key, with its default, is the shipped app/assets/booth.toml (installed as /etc/avatarbooth/booth.toml).
+// line and the key (ErrorKind::BadConfig), so a typo never silently falls back to a default. Every key, its type,
+// range and doc are in config/config_schema.h; the reference with the defaults is `avatarbooth config
+// --print-default` (kept as app/assets/booth.toml, installed as /etc/avatarbooth/booth.toml).
 #pragma once
 
 #include "animation/avatar_motion.h"

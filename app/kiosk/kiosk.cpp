@@ -47,13 +47,6 @@ constexpr auto kReleaseAfter = std::chrono::milliseconds(120);    // a simulated
 constexpr auto kRetentionEvery = std::chrono::minutes(10);
 constexpr auto kWatchdogEvery = std::chrono::seconds(1);
 
-std::optional<Button> buttonNamed(const std::string& name) {
-    if (name == "start") return Button::Start;
-    if (name == "retake") return Button::Retake;
-    if (name == "service") return Button::Service;
-    return std::nullopt;
-}
-
 // The fraction of the fit done when a stage starts (the stages' shares of the time measured by `bench`).
 double stageProgress(const std::string& stage) {
     if (stage == "front_landmarks") return 0.05;
@@ -581,7 +574,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         if (board.keyboard)
             for (const auto& key : display.pollKeys()) board.keyboard->feed(key.key, key.pressed, key.time);
         while (auto e = board.buttons->poll(std::chrono::milliseconds(0))) {
-            if (const auto b = buttonNamed(e->button)) {
+            if (const auto b = parseButton(e->button)) {
                 if (e->action == ButtonAction::Press) events.push_back(ButtonPressed{*b, now});
                 else events.push_back(ButtonReleased{*b, now});
             }

@@ -1,17 +1,34 @@
-// booth.toml: the shipped reference equals the built-in defaults, values land in the parts' settings, and every
-// kind of mistake is an error naming the file, the line and the key.
+// booth.toml: the schema's printed default parses back to the built-in defaults and is the shipped file, the
+// README's reference is the schema's, every key lands in its setting, and every kind of mistake is an error naming
+// the file, the line and the key.
 #include "test_paths.h"
 
 #include "config/booth_config.h"
+#include "config/config_schema.h"
 #include "common/error.h"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
 
 using namespace avatarbooth;
 
 namespace {
 
-const std::filesystem::path kShipped = std::filesystem::path(AVATARBOOTH_TEST_SOURCE_DIR) / "app/assets/booth.toml";
+const std::filesystem::path kSource = AVATARBOOTH_TEST_SOURCE_DIR;
+const std::filesystem::path kShipped = kSource / "app/assets/booth.toml";
+constexpr const char* kRegenerate = "run tests/update_config_reference.sh (after building avatarbooth) to regenerate it";
+
+std::string readText(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
 
 // The message of the BadConfig error the text raises ("" when it raises none).
 std::string errorOf(const std::string& text) {
@@ -24,11 +41,37 @@ std::string errorOf(const std::string& text) {
     return "";
 }
 
-}  // namespace
 
-TEST(Config, ShippedReferenceEqualsTheDefaults) {
-    const BoothConfig shipped = loadBoothConfig(kShipped);
-    const BoothConfig defaults = parseBoothConfig("", "empty.toml");
+// Field by field, every setting the file can hold (independently of the schema's own get()).
+void expectSameSettings(const BoothConfig& shipped, const BoothConfig& defaults) {
+    EXPECT_EQ(shipped.fit.baseMesh, defaults.fit.baseMesh);
+    EXPECT_EQ(shipped.fit.baseFeatures, defaults.fit.baseFeatures);
+    EXPECT_EQ(shipped.camera.device, defaults.camera.device);
+    EXPECT_EQ(shipped.camera.stillWidth, defaults.camera.stillWidth);
+    EXPECT_EQ(shipped.camera.stillHeight, defaults.camera.stillHeight);
+    EXPECT_EQ(shipped.camera.bufferCount, defaults.camera.bufferCount);
+    EXPECT_EQ(shipped.camera.simFolder, defaults.camera.simFolder);
+    EXPECT_DOUBLE_EQ(shipped.camera.simFps, defaults.camera.simFps);
+    EXPECT_EQ(shipped.camera.simRealTime, defaults.camera.simRealTime);
+    EXPECT_DOUBLE_EQ(shipped.camera.reopenFirstDelaySeconds, defaults.camera.reopenFirstDelaySeconds);
+    EXPECT_EQ(shipped.buttons.backend, defaults.buttons.backend);
+    EXPECT_EQ(shipped.buttons.consumer, defaults.buttons.consumer);
+    EXPECT_EQ(shipped.buttons.timeline, defaults.buttons.timeline);
+    EXPECT_EQ(shipped.display.rotation, defaults.display.rotation);
+    EXPECT_EQ(shipped.display.drmDevice, defaults.display.drmDevice);
+    EXPECT_EQ(shipped.display.connector, defaults.display.connector);
+    EXPECT_EQ(shipped.display.everyNthFrame, defaults.display.everyNthFrame);
+    EXPECT_EQ(shipped.display.framesDir, defaults.display.framesDir);
+    EXPECT_EQ(shipped.display.windowTitle, defaults.display.windowTitle);
+    EXPECT_EQ(shipped.screen.fonts.regular, defaults.screen.fonts.regular);
+    EXPECT_EQ(shipped.screen.fonts.bold, defaults.screen.fonts.bold);
+    EXPECT_EQ(shipped.screen.fonts.japanese, defaults.screen.fonts.japanese);
+    EXPECT_EQ(shipped.screen.stringsFile, defaults.screen.stringsFile);
+    EXPECT_DOUBLE_EQ(shipped.guidance.oval.centreX, defaults.guidance.oval.centreX);
+    EXPECT_DOUBLE_EQ(shipped.guidance.oval.centreY, defaults.guidance.oval.centreY);
+    EXPECT_DOUBLE_EQ(shipped.screen.oval.height, defaults.screen.oval.height);
+    for (std::size_t i = 0; i < std::min(shipped.buttons.lamps.size(), defaults.buttons.lamps.size()); ++i)
+        EXPECT_EQ(shipped.buttons.lamps[i].activeLow, defaults.buttons.lamps[i].activeLow);
     EXPECT_EQ(shipped.fit.settings.landmarkModel, defaults.fit.settings.landmarkModel);
     EXPECT_EQ(shipped.fit.settings.head.rbf.kernel, defaults.fit.settings.head.rbf.kernel);
     EXPECT_DOUBLE_EQ(shipped.fit.settings.head.rbf.unitMm, defaults.fit.settings.head.rbf.unitMm);
@@ -85,8 +128,133 @@ TEST(Config, ShippedReferenceEqualsTheDefaults) {
     EXPECT_EQ(shipped.animation.style, defaults.animation.style);
     EXPECT_DOUBLE_EQ(shipped.animation.fps, defaults.animation.fps);
     EXPECT_EQ(shipped.animation.inbetweenOmissions, defaults.animation.inbetweenOmissions);
-    EXPECT_NEAR(shipped.animation.holdFraction, defaults.animation.holdFraction, 1e-12);
+    EXPECT_DOUBLE_EQ(shipped.animation.holdFraction, defaults.animation.holdFraction);
 }
+
+// Every key through the schema: the value read from `a` equals the one read from `b`.
+void expectSameKeys(const BoothConfig& a, const BoothConfig& b) {
+    for (const ConfigTable& table : configTables()) {
+        if (table.kind == ConfigTableKind::StringMap) {
+            BoothConfig ca = a, cb = b;
+            EXPECT_EQ(table.map(ca), table.map(cb)) << table.name;
+            continue;
+        }
+        const std::size_t n = table.kind == ConfigTableKind::Repeated ? table.count(a) : 1;
+        if (table.kind == ConfigTableKind::Repeated) {
+            ASSERT_EQ(n, table.count(b)) << table.name;
+        }
+        for (const ConfigKey& k : configKeys()) {
+            if (k.table != table.name) continue;
+            for (std::size_t i = 0; i < n; ++i) {
+                EXPECT_EQ(k.get(a, i), k.get(b, i)) << k.table << "." << k.name << " [" << i << "]";
+            }
+        }
+    }
+}
+
+}  // namespace
+
+TEST(Config, PrintedDefaultParsesBackToTheStructDefaults) {
+    const BoothConfig printed = parseBoothConfig(renderDefaultConfig(), "default.toml");
+    const BoothConfig defaults;
+    expectSameSettings(printed, defaults);
+    expectSameKeys(printed, defaults);
+    // An empty file is the same configuration.
+    expectSameKeys(parseBoothConfig("", "empty.toml"), defaults);
+}
+
+TEST(Config, ShippedFileIsThePrintedDefault) {
+    EXPECT_EQ(readText(kShipped), renderDefaultConfig())
+        << "app/assets/booth.toml differs from `avatarbooth config --print-default`: " << kRegenerate;
+    expectSameSettings(loadBoothConfig(kShipped), BoothConfig{});
+}
+
+TEST(Config, ReadmeReferenceIsGenerated) {
+    const std::string readme = readText(kSource / "README.md");
+    const std::string begin = "<!-- config-reference:begin -->\n", end = "<!-- config-reference:end -->";
+    const auto b = readme.find(begin);
+    const auto e = readme.find(end);
+    ASSERT_NE(b, std::string::npos) << "README.md has no " << begin;
+    ASSERT_NE(e, std::string::npos) << "README.md has no " << end;
+    ASSERT_LT(b, e);
+    EXPECT_EQ(readme.substr(b + begin.size(), e - b - begin.size()), renderConfigReference())
+        << "the README's config reference differs from `avatarbooth config --reference`: " << kRegenerate;
+}
+
+TEST(Config, SchemaDefaultsAreAllowedValues) {
+    const BoothConfig defaults;
+    std::set<std::string> names;
+    for (const ConfigKey& k : configKeys()) {
+        const std::string key = k.table + "." + k.name;
+        EXPECT_TRUE(names.insert(key).second) << key << " is in the schema twice";
+        EXPECT_FALSE(k.doc.empty()) << key << " has no doc";
+        EXPECT_TRUE(std::any_of(configTables().begin(), configTables().end(), [&](const ConfigTable& t) { return t.name == k.table; }))
+            << key << ": no such table";
+        const std::size_t n = k.table.starts_with("buttons.") ? 2 : 1;
+        for (std::size_t i = 0; i < n; ++i) {
+            const ConfigValue v = k.get(defaults, i);
+            if (k.type == ConfigType::Choice) {
+                EXPECT_NE(std::find(k.choices.begin(), k.choices.end(), std::get<std::string>(v)), k.choices.end()) << key;
+            }
+            if (k.type == ConfigType::Integer) {
+                const auto x = static_cast<double>(std::get<long long>(v));
+                EXPECT_TRUE(x >= k.min && x <= k.max) << key;
+            }
+            if (k.type == ConfigType::Number || k.type == ConfigType::Seconds) {
+                EXPECT_TRUE(std::get<double>(v) >= k.min && std::get<double>(v) <= k.max) << key;
+            }
+        }
+    }
+}
+
+// Each key, set to a value other than its default in a file of its own, arrives in its setting: no key of the
+// schema is left unread or written to the wrong field.
+TEST(Config, EveryKeyLandsInItsSetting) {
+    const BoothConfig defaults;
+    for (const ConfigKey& k : configKeys()) {
+        const std::string key = k.table + "." + k.name;
+        const ConfigValue before = k.get(defaults, 0);
+        std::vector<ConfigValue> candidates;
+        switch (k.type) {
+            case ConfigType::String:
+            case ConfigType::Path: candidates = {std::string("/srv/other")}; break;
+            case ConfigType::Bool: candidates = {!std::get<bool>(before)}; break;
+            case ConfigType::Integer:
+                candidates = {static_cast<long long>(k.min), static_cast<long long>(k.max)};
+                break;
+            case ConfigType::Number:
+            case ConfigType::Seconds: candidates = {k.min, k.max, (k.min + k.max) / 2}; break;
+            case ConfigType::Choice:
+                for (const auto& c : k.choices) candidates.emplace_back(c);
+                break;
+            case ConfigType::ButtonCombo: candidates = {std::string("service"), std::string("retake+service")}; break;
+        }
+        // A repeated table's element needs its required keys; fit's base head needs both files.
+        std::string head = "[" + k.table + "]\n";
+        if (k.table == "buttons.button" || k.table == "buttons.lamp")
+            head = "[[" + k.table + "]]\n" + (k.name == "name" ? "" : "name = \"start\"\n");
+        if (key == "fit.base_mesh") head += "base_features = \"f.json\"\n";
+        if (key == "fit.base_features") head += "base_mesh = \"m.glb\"\n";
+        bool landed = false;
+        std::string errors;
+        for (const ConfigValue& v : candidates) {
+            if (v == before) continue;
+            try {
+                const BoothConfig c = parseBoothConfig(head + k.name + " = " + tomlValue(v) + "\n", "booth.toml");
+                EXPECT_EQ(k.get(c, 0), v) << key << " = " << tomlValue(v);
+                landed = true;
+                break;
+            } catch (const BoothError& e) {
+                errors += std::string(e.what()) + "\n";  // a rule across keys refused this one: try the next
+            }
+        }
+        EXPECT_TRUE(landed) << key << ": no value other than the default was accepted:\n" << errors;
+    }
+    // Key bindings: the table replaces the defaults.
+    const BoothConfig keys = parseBoothConfig("[buttons.keys]\nF1 = \"service\"\n", "booth.toml");
+    EXPECT_EQ(keys.buttons.keys, (std::map<std::string, std::string>{{"F1", "service"}}));
+}
+
 
 TEST(Config, ValuesLandInTheirSettings) {
     const BoothConfig c = parseBoothConfig(R"(
@@ -162,6 +330,44 @@ TEST(Config, MistakesNameFileLineAndKey) {
     // Not TOML at all: the parser's own message, with the line.
     const std::string bad = errorOf("[camera]\nbackend = \"sim\n");
     EXPECT_EQ(bad.rfind("booth.toml:2: not valid TOML: ", 0), 0u) << bad;
+}
+
+// More broken files, one per kind of check the schema drives: the line named is the offending value's.
+TEST(Config, BrokenFilesNameFileLineAndKey) {
+    // Wrong types.
+    EXPECT_EQ(errorOf("[camera]\nsim_real_time = \"yes\"\n"), "booth.toml:2: camera.sim_real_time: expected true or false");
+    EXPECT_EQ(errorOf("[fit]\nlandmark_model = 5\n"), "booth.toml:2: fit.landmark_model: expected a string in quotes");
+    EXPECT_EQ(errorOf("[flow]\ncountdown_s = \"3\"\n"), "booth.toml:2: flow.countdown_s: expected a number");
+    EXPECT_EQ(errorOf("guidance = 3\n"), "booth.toml:1: guidance: expected a table ([guidance])");
+    EXPECT_EQ(errorOf("[buttons]\nbutton = 17\n"), "booth.toml:2: buttons.button: expected tables ([[buttons.button]])");
+    // Out of range, in nested and repeated tables too.
+    EXPECT_EQ(errorOf("[guidance.oval]\n\nheight = 1.5\n"), "booth.toml:3: guidance.oval.height: must be between 0.2 and 1, got 1.5");
+    EXPECT_EQ(errorOf("[[buttons.lamp]]\nname = \"flash\"\noffset = 2048\n"),
+              "booth.toml:3: buttons.lamp[0].offset: must be between 0 and 1023, got 2048");
+    EXPECT_EQ(errorOf("[flow]\ncountdown_s = 0.5\n"), "booth.toml:2: flow.countdown_s: must be between 1 and 10, got 0.5");
+    EXPECT_EQ(errorOf("[display]\nrotation = 360\n"), "booth.toml:2: display.rotation: must be 0, 90, 180 or 270");
+    // Bad choices.
+    EXPECT_EQ(errorOf("[[buttons.button]]\nname = \"start\"\nbias = \"up\"\n"),
+              "booth.toml:3: buttons.button[0].bias: \"up\" is not one of \"pull-up\", \"pull-down\", \"disabled\" or \"as-is\"");
+    EXPECT_EQ(errorOf("[screen]\nlanguage = \"de\"\n"), "booth.toml:2: screen.language: \"de\" is not one of \"en\" or \"ja\"");
+    EXPECT_EQ(errorOf("[buttons.keys]\nspace = \"start\"\nx = \"exit\"\n"),
+              "booth.toml:3: buttons.keys.x: \"exit\" is not one of \"start\", \"retake\" or \"service\"");
+    EXPECT_EQ(errorOf("[flow]\nlock_combo = \"\"\n"), "booth.toml:2: flow.lock_combo: name at least one button");
+    // Unknown keys in nested and repeated tables; a missing required key names its element's line.
+    EXPECT_EQ(errorOf("[guidance.oval]\nwidth = 0.5\n"),
+              "booth.toml:2: guidance.oval.width: unknown key (see the reference booth.toml for the keys there are)");
+    EXPECT_EQ(errorOf("[[buttons.lamp]]\nname = \"flash\"\n[[buttons.lamp]]\noffset = 5\n"),
+              "booth.toml:3: buttons.lamp[1].name: every [[buttons.lamp]] needs a name");
+    EXPECT_EQ(errorOf("[camera]\nreopen_first_delay_s = 10\nreopen_max_delay_s = 2\n"),
+              "booth.toml:3: camera.reopen_max_delay_s: must not be shorter than reopen_first_delay_s");
+    EXPECT_EQ(errorOf("[flow]\nthanks_min_time_s = 30\n"),
+              "booth.toml:2: flow.thanks_min_time_s: must not be longer than thanks_time_s");
+}
+
+TEST(Config, DurationsRoundToTheMillisecond) {
+    const BoothConfig c = parseBoothConfig("[flow]\npress_guard_s = 0.29\nlock_hold_s = 2.0006\n", "booth.toml");
+    EXPECT_EQ(c.flow.pressGuard, Millis(290));
+    EXPECT_EQ(c.flow.lockHold, Millis(2001));
 }
 
 TEST(Config, MissingFileIsBadInput) {

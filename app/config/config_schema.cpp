@@ -1,0 +1,607 @@
+// Every table and key of booth.toml, and the default file and Markdown reference rendered from them.
+#include "config/config_schema.h"
+
+#include "head/rbf.h"
+
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <type_traits>
+
+namespace avatarbooth {
+namespace {
+
+// A key's field in BoothConfig, written once and used for reading (const) and writing: FIELD(camera.device) for a
+// plain table's key, ELEMENT(buttons.buttons[i].offset) for a key of a Repeated table's i-th element.
+#define FIELD(expr) [](auto& c) -> auto& { return c.expr; }
+#define ELEMENT(expr) [](auto& c, std::size_t i) -> auto& { return c.expr; }
+
+template <typename Ref, typename C>
+decltype(auto) at(const Ref& ref, C& c, std::size_t i) {
+    if constexpr (std::is_invocable_v<const Ref&, C&, std::size_t>) return ref(c, i);
+    else return ref(c);
+}
+
+std::string asText(const std::string& s) { return s; }
+std::string asText(const std::filesystem::path& p) { return p.string(); }
+
+template <typename Ref>
+ConfigKey textKey(std::string table, std::string name, ConfigType type, Ref ref, std::string doc) {
+    ConfigKey k{.table = std::move(table), .name = std::move(name), .type = type, .doc = std::move(doc)};
+    k.get = [ref](const BoothConfig& c, std::size_t i) { return ConfigValue(asText(at(ref, c, i))); };
+    k.set = [ref](BoothConfig& c, std::size_t i, const ConfigValue& v) { at(ref, c, i) = std::get<std::string>(v); };
+    return k;
+}
+template <typename Ref>
+ConfigKey text(std::string table, std::string name, Ref ref, std::string doc) {
+    return textKey(std::move(table), std::move(name), ConfigType::String, ref, std::move(doc));
+}
+template <typename Ref>
+ConfigKey path(std::string table, std::string name, Ref ref, std::string doc) {
+    return textKey(std::move(table), std::move(name), ConfigType::Path, ref, std::move(doc));
+}
+
+template <typename Ref>
+ConfigKey choice(std::string table, std::string name, Ref ref, std::vector<std::string> choices, std::string doc) {
+    ConfigKey k = textKey(std::move(table), std::move(name), ConfigType::Choice, ref, std::move(doc));
+    k.choices = std::move(choices);
+    return k;
+}
+
+template <typename Ref>
+ConfigKey flag(std::string table, std::string name, Ref ref, std::string doc) {
+    ConfigKey k{.table = std::move(table), .name = std::move(name), .type = ConfigType::Bool, .doc = std::move(doc)};
+    k.get = [ref](const BoothConfig& c, std::size_t i) { return ConfigValue(static_cast<bool>(at(ref, c, i))); };
+    k.set = [ref](BoothConfig& c, std::size_t i, const ConfigValue& v) { at(ref, c, i) = std::get<bool>(v); };
+    return k;
+}
+
+template <typename Ref>
+ConfigKey integer(std::string table, std::string name, Ref ref, long long lo, long long hi, std::string doc,
+                  long long step = 1) {
+    ConfigKey k{.table = std::move(table), .name = std::move(name), .type = ConfigType::Integer,
+                .min = static_cast<double>(lo), .max = static_cast<double>(hi), .step = step, .doc = std::move(doc)};
+    k.get = [ref](const BoothConfig& c, std::size_t i) { return ConfigValue(static_cast<long long>(at(ref, c, i))); };
+    k.set = [ref](BoothConfig& c, std::size_t i, const ConfigValue& v) {
+        auto& field = at(ref, c, i);
+        field = static_cast<std::remove_reference_t<decltype(field)>>(std::get<long long>(v));
+    };
+    return k;
+}
+
+template <typename Ref>
+ConfigKey number(std::string table, std::string name, Ref ref, double lo, double hi, std::string doc) {
+    ConfigKey k{.table = std::move(table), .name = std::move(name), .type = ConfigType::Number, .min = lo, .max = hi,
+                .doc = std::move(doc)};
+    k.get = [ref](const BoothConfig& c, std::size_t i) { return ConfigValue(static_cast<double>(at(ref, c, i))); };
+    k.set = [ref](BoothConfig& c, std::size_t i, const ConfigValue& v) { at(ref, c, i) = std::get<double>(v); };
+    return k;
+}
+
+// A std::chrono::duration field given in seconds; rounded to the field's own tick (milliseconds), so 0.29 s is
+// 290 ms and not 289.
+template <typename Ref>
+ConfigKey seconds(std::string table, std::string name, Ref ref, double lo, double hi, std::string doc) {
+    ConfigKey k{.table = std::move(table), .name = std::move(name), .type = ConfigType::Seconds, .min = lo, .max = hi,
+                .doc = std::move(doc)};
+    k.get = [ref](const BoothConfig& c, std::size_t i) {
+        return ConfigValue(std::chrono::duration<double>(at(ref, c, i)).count());
+    };
+    k.set = [ref](BoothConfig& c, std::size_t i, const ConfigValue& v) {
+        auto& field = at(ref, c, i);
+        field = std::chrono::round<std::remove_reference_t<decltype(field)>>(std::chrono::duration<double>(std::get<double>(v)));
+    };
+    return k;
+}
+
+// A retention age (std::chrono::seconds) given in `Unit`s (hours, days).
+template <typename Unit, typename Ref>
+ConfigKey age(std::string table, std::string name, Ref ref, double lo, double hi, std::string doc) {
+    ConfigKey k{.table = std::move(table), .name = std::move(name), .type = ConfigType::Number, .min = lo, .max = hi,
+                .doc = std::move(doc)};
+    k.get = [ref](const BoothConfig& c, std::size_t i) {
+        return ConfigValue(std::chrono::duration<double, Unit>(at(ref, c, i)).count());
+    };
+    k.set = [ref](BoothConfig& c, std::size_t i, const ConfigValue& v) {
+        const double s = std::get<double>(v) * static_cast<double>(Unit::num) / static_cast<double>(Unit::den);
+        at(ref, c, i) = std::chrono::seconds(static_cast<long long>(std::llround(s)));
+    };
+    return k;
+}
+
+// A choice stored as an enum: `name` and `parse` translate.
+template <typename Ref, typename Name, typename Parse>
+ConfigKey enumChoice(std::string table, std::string name, Ref ref, std::vector<std::string> choices, Name toName,
+                     Parse parse, std::string doc) {
+    ConfigKey k{.table = std::move(table), .name = std::move(name), .type = ConfigType::Choice,
+                .choices = std::move(choices), .doc = std::move(doc)};
+    k.get = [ref, toName](const BoothConfig& c, std::size_t i) { return ConfigValue(std::string(toName(at(ref, c, i)))); };
+    k.set = [ref, parse](BoothConfig& c, std::size_t i, const ConfigValue& v) { at(ref, c, i) = parse(std::get<std::string>(v)); };
+    return k;
+}
+
+const char* biasName(LineBias bias) {
+    switch (bias) {
+        case LineBias::PullUp: return "pull-up";
+        case LineBias::PullDown: return "pull-down";
+        case LineBias::Disabled: return "disabled";
+        case LineBias::AsIs: return "as-is";
+    }
+    return "?";
+}
+LineBias parseBias(const std::string& word) {
+    if (word == "pull-down") return LineBias::PullDown;
+    if (word == "disabled") return LineBias::Disabled;
+    if (word == "as-is") return LineBias::AsIs;
+    return LineBias::PullUp;  // the only other choice the schema lets through
+}
+
+std::vector<std::string> buttonNames() {
+    std::vector<std::string> names;
+    for (const Button b : {Button::Start, Button::Retake, Button::Service}) names.emplace_back(toString(b));
+    return names;
+}
+
+ConfigKey lockCombo() {
+    ConfigKey k{.table = "flow", .name = "lock_combo", .type = ConfigType::ButtonCombo,
+                .doc = "The operator menu opens when exactly these buttons (joined by +) are held together for "
+                       "lock_hold_s; a booth with a Service button inside the cabinet can use \"service\" alone."};
+    k.get = [](const BoothConfig& c, std::size_t) {
+        std::string combo;
+        for (const Button b : c.flow.lockCombo) combo += (combo.empty() ? "" : "+") + std::string(toString(b));
+        return ConfigValue(combo);
+    };
+    k.set = [](BoothConfig& c, std::size_t, const ConfigValue& v) {
+        std::vector<Button> lock;
+        std::stringstream in(std::get<std::string>(v));
+        for (std::string word; std::getline(in, word, '+');) {
+            const std::optional<Button> b = parseButton(word);
+            if (!b) throw ConfigValueRejected{"\"" + word + "\" is not a button (start, retake, service; joined by +)"};
+            lock.push_back(*b);
+        }
+        if (lock.empty()) throw ConfigValueRejected{"name at least one button"};
+        c.flow.lockCombo = lock;
+    };
+    return k;
+}
+
+std::vector<ConfigTable> makeTables() {
+    std::vector<ConfigTable> t;
+    t.push_back({.name = "fit",
+                 .doc = "The photo-to-head pipeline.",
+                 .check = [](const BoothConfig& c) -> std::optional<ConfigProblem> {
+                     if (c.fit.baseMesh.empty() == c.fit.baseFeatures.empty()) return std::nullopt;
+                     return ConfigProblem{c.fit.baseMesh.empty() ? "base_features" : "base_mesh",
+                                          "give both base_mesh and base_features, or neither"};
+                 }});
+    t.push_back({.name = "camera",
+                 .doc = "The camera: which stack, the preview and photo sizes, the simulated camera, reopening after a "
+                        "camera went away.",
+                 .check = [](const BoothConfig& c) -> std::optional<ConfigProblem> {
+                     if (c.camera.reopenMaxDelaySeconds >= c.camera.reopenFirstDelaySeconds) return std::nullopt;
+                     return ConfigProblem{"reopen_max_delay_s", "must not be shorter than reopen_first_delay_s"};
+                 }});
+    t.push_back({.name = "buttons",
+                 .doc = "The arcade buttons and their lamps on the GPIO chip, or the simulated ones.",
+                 .check = [](const BoothConfig& c) -> std::optional<ConfigProblem> {
+                     std::set<unsigned> lines;
+                     for (const auto& b : c.buttons.buttons)
+                         if (!lines.insert(b.offset).second)
+                             return ConfigProblem{"button", "line " + std::to_string(b.offset) + " is used twice"};
+                     for (const auto& l : c.buttons.lamps)
+                         if (!lines.insert(l.offset).second)
+                             return ConfigProblem{"lamp", "line " + std::to_string(l.offset) + " is used twice"};
+                     return std::nullopt;
+                 }});
+    t.push_back({.name = "buttons.button",
+                 .kind = ConfigTableKind::Repeated,
+                 .doc = "One table per button (given at all, they replace the default buttons). Defaults: start on "
+                        "BCM 17 (header pin 11), retake on BCM 27 (pin 13), each wired to ground.",
+                 .count = [](const BoothConfig& c) { return c.buttons.buttons.size(); },
+                 .reset = [](BoothConfig& c, std::size_t n) { c.buttons.buttons.assign(n, ButtonSettings{}); }});
+    t.push_back({.name = "buttons.lamp",
+                 .kind = ConfigTableKind::Repeated,
+                 .doc = "One table per lamp (given at all, they replace the default lamps). Defaults: BCM 22 (pin 15) "
+                        "the start button's lamp, 23 (pin 16) the retake button's, 24 (pin 18) the flash.",
+                 .count = [](const BoothConfig& c) { return c.buttons.lamps.size(); },
+                 .reset = [](BoothConfig& c, std::size_t n) { c.buttons.lamps.assign(n, LampSettings{}); }});
+    t.push_back({.name = "buttons.keys",
+                 .kind = ConfigTableKind::StringMap,
+                 .doc = "Keyboard keys (X11 key names) that press a button while the development window is open: "
+                        "key = \"button\". Given at all, the table replaces the default keys.",
+                 .map = [](BoothConfig& c) -> std::map<std::string, std::string>& { return c.buttons.keys; },
+                 .valueChoices = buttonNames()});
+    t.push_back({.name = "display", .doc = "The screen: which backend, the panel's rotation and size."});
+    t.push_back({.name = "screen", .doc = "What the screens show: language, fonts, strings, button sides."});
+    t.push_back({.name = "flow",
+                 .doc = "The visitor flow's timing and the operator lock. Durations in seconds.",
+                 .check = [](const BoothConfig& c) -> std::optional<ConfigProblem> {
+                     if (c.flow.thanksMinTime <= c.flow.thanksTime) return std::nullopt;
+                     return ConfigProblem{"thanks_min_time_s", "must not be longer than thanks_time_s"};
+                 }});
+    t.push_back({.name = "guidance", .doc = "How the guide screens place the visitor."});
+    t.push_back({.name = "guidance.oval",
+                 .doc = "The face oval of the guide screens, as fractions of the camera frame (the screen draws the "
+                        "same oval)."});
+    t.push_back({.name = "sessions",
+                 .doc = "Kept sessions. Photos of visitors are personal data: the folder is readable by the booth's "
+                        "user only, and photos are deleted after photo_retention_hours.",
+                 .check = [](const BoothConfig& c) -> std::optional<ConfigProblem> {
+                     const auto& s = c.sessions;
+                     if (s.sessionRetention.count() == 0 || s.photoRetention.count() == 0 ||
+                         s.sessionRetention >= s.photoRetention)
+                         return std::nullopt;
+                     return ConfigProblem{"session_retention_days",
+                                          "sessions would be deleted before their photos' retention ends"};
+                 }});
+    t.push_back({.name = "animation", .doc = "The avatar's turn on the reveal and attract screens."});
+    return t;
+}
+
+std::vector<ConfigKey> makeKeys() {
+    std::vector<ConfigKey> k;
+    // [fit]
+    k.push_back(path("fit", "landmark_model", FIELD(fit.settings.landmarkModel),
+                     "dlib's 68-point shape predictor (Debian: libdlib-data). It was trained on iBUG 300-W, whose terms "
+                     "exclude commercial use: a commercial booth needs a model trained on data it may use."));
+    k.push_back(path("fit", "base_mesh", FIELD(fit.baseMesh),
+                     "Your own base head instead of the built-in one: a glb with UVs (`avatarbooth make-base-head -o "
+                     "DIR` writes the built-in pair to start from); \"\" = the built-in head."));
+    k.push_back(path("fit", "base_features", FIELD(fit.baseFeatures),
+                     "The feature file of base_mesh; give both or neither."));
+    k.push_back(enumChoice(
+        "fit", "rbf_kernel", FIELD(fit.settings.head.rbf.kernel), {"ntt", "tps", "gaussian"},
+        [](RbfKernel r) { return rbfKernelName(r); }, [](const std::string& s) { return parseRbfKernel(s); },
+        "RBF kernel of the warp: \"ntt\" (the paper's f(r) = 1/(r+1)), \"tps\" (thin-plate spline with an affine "
+        "part), \"gaussian\"."));
+    k.push_back(number("fit", "rbf_unit_mm", FIELD(fit.settings.head.rbf.unitMm), 1.0, 500.0,
+                       "The RBF's distance r is measured in units of this many millimetres."));
+    k.push_back(integer("fit", "texture_size", FIELD(fit.settings.texture.size), 256, 4096,
+                        "The avatar's texture, texels per side."));
+    k.push_back(integer("fit", "preview_size", FIELD(fit.settings.previewSize), 64, 4096,
+                        "The preview renders of a session, pixels per side."));
+    // [camera]
+    k.push_back(choice("camera", "backend", FIELD(camera.backend), {"auto", "v4l2", "libcamera", "sim"},
+                       "\"auto\" (a V4L2 camera if there is one, else libcamera, else the simulated camera), "
+                       "\"v4l2\", \"libcamera\", \"sim\"."));
+    k.push_back(text("camera", "device", FIELD(camera.device),
+                     "v4l2: \"/dev/video0\" or a stable /dev/v4l/by-id/... name; libcamera: the camera id from "
+                     "`avatarbooth check`; \"\" = the first one found."));
+    k.push_back(integer("camera", "preview_width", FIELD(camera.previewWidth), 64, 8192,
+                        "The preview stream's wanted width (the nearest the camera offers is used)."));
+    k.push_back(integer("camera", "preview_height", FIELD(camera.previewHeight), 64, 8192,
+                        "The preview stream's wanted height."));
+    k.push_back(number("camera", "preview_fps", FIELD(camera.previewFps), 1.0, 240.0,
+                       "The preview stream's wanted frame rate."));
+    k.push_back(integer("camera", "still_width", FIELD(camera.stillWidth), 0, 16384,
+                        "The photo's width; 0 (with still_height 0) = the largest the camera offers."));
+    k.push_back(integer("camera", "still_height", FIELD(camera.stillHeight), 0, 16384, "The photo's height."));
+    k.push_back(integer("camera", "still_warmup_frames", FIELD(camera.stillWarmupFrames), 0, 100,
+                        "Frames dropped after switching to the still format while exposure settles."));
+    k.push_back(integer("camera", "buffer_count", FIELD(camera.bufferCount), 2, 32,
+                        "Driver buffers for streaming (V4L2 buffers, libcamera requests)."));
+    k.push_back(path("camera", "sim_folder", FIELD(camera.simFolder),
+                     "sim: replay this recorded session folder (front.*, side.*, optional background.*); \"\" = the "
+                     "synthetic visitor the booth makes itself."));
+    k.push_back(number("camera", "sim_fps", FIELD(camera.simFps), 1.0, 240.0, "sim: frames per second."));
+    k.push_back(flag("camera", "sim_real_time", FIELD(camera.simRealTime),
+                     "sim: frames come in real time (false: as fast as they are asked for, for tests)."));
+    k.push_back(integer("camera", "sim_noise", FIELD(camera.simNoise), 0, 64,
+                        "sim: sensor noise added to preview frames, grey levels (0 = identical frames)."));
+    k.push_back(number("camera", "reopen_first_delay_s", FIELD(camera.reopenFirstDelaySeconds), 0.01, 60.0,
+                       "A camera that went away is reopened after this delay, doubling up to reopen_max_delay_s."));
+    k.push_back(number("camera", "reopen_max_delay_s", FIELD(camera.reopenMaxDelaySeconds), 0.01, 600.0,
+                       "The longest delay between reopening attempts."));
+    // [buttons]
+    k.push_back(choice("buttons", "backend", FIELD(buttons.backend), {"auto", "gpiod", "sim"},
+                       "\"auto\" (the GPIO chip when it exists, else simulated), \"gpiod\", \"sim\"."));
+    k.push_back(text("buttons", "chip", FIELD(buttons.chip),
+                     "The GPIO chip by label (\"pinctrl-bcm2711\"), name (\"gpiochip0\"), path or number."));
+    k.push_back(integer("buttons", "debounce_ms", FIELD(buttons.debounceMs), 0, 1000,
+                        "Edges closer than this are one press (contact bounce), milliseconds; 0 turns debouncing off."));
+    k.push_back(text("buttons", "consumer", FIELD(buttons.consumer),
+                     "The name the lines are requested under (what `gpioinfo` shows)."));
+    k.push_back(path("buttons", "timeline", FIELD(buttons.timeline),
+                     "sim: a scripted button timeline file (\"at 2.0s press start\"), see drivers/gpio/README.md; "
+                     "\"\" = no scripted presses."));
+    // [[buttons.button]]
+    ConfigKey buttonName = choice("buttons.button", "name", ELEMENT(buttons.buttons[i].name), buttonNames(),
+                                  "The button: \"start\", \"retake\" or \"service\".");
+    buttonName.required = true;
+    k.push_back(buttonName);
+    k.push_back(integer("buttons.button", "offset", ELEMENT(buttons.buttons[i].offset), 0, 1023,
+                        "The line offset on the chip (the BCM number on a Raspberry Pi)."));
+    k.push_back(flag("buttons.button", "active_low", ELEMENT(buttons.buttons[i].activeLow),
+                     "Pressed reads low (the button connects the line to ground)."));
+    k.push_back(enumChoice(
+        "buttons.button", "bias", ELEMENT(buttons.buttons[i].bias), {"pull-up", "pull-down", "disabled", "as-is"},
+        biasName, parseBias, "The pull resistor asked of the GPIO controller."));
+    // [[buttons.lamp]]
+    ConfigKey lampName = choice("buttons.lamp", "name", ELEMENT(buttons.lamps[i].name), {"start", "retake", "flash"},
+                                "The lamp: \"start\" / \"retake\" (the buttons' lamps) or \"flash\".");
+    lampName.required = true;
+    k.push_back(lampName);
+    k.push_back(integer("buttons.lamp", "offset", ELEMENT(buttons.lamps[i].offset), 0, 1023,
+                        "The line offset on the chip."));
+    k.push_back(flag("buttons.lamp", "active_low", ELEMENT(buttons.lamps[i].activeLow),
+                     "The lamp lights with the line low (many relay boards)."));
+    // [display]
+    k.push_back(choice("display", "backend", FIELD(display.backend), {"auto", "kms", "window", "headless"},
+                       "\"auto\" (KMS when a screen is connected, else a window when $DISPLAY is set, else "
+                       "headless), \"kms\", \"window\", \"headless\"."));
+    k.push_back(integer("display", "rotation", FIELD(display.rotation), 0, 270,
+                        "Degrees the picture is turned clockwise for the panel (portrait panels: 90 or 270).", 90));
+    k.push_back(integer("display", "width", FIELD(display.width), 64, 8192,
+                        "Width for the window and headless backends (KMS uses the screen's own mode)."));
+    k.push_back(integer("display", "height", FIELD(display.height), 64, 8192,
+                        "Height for the window and headless backends."));
+    k.push_back(path("display", "drm_device", FIELD(display.drmDevice),
+                     "kms: the DRM device; \"\" = the first /dev/dri/card* with a connected screen."));
+    k.push_back(text("display", "connector", FIELD(display.connector),
+                     "kms: the connector (\"HDMI-A-1\", \"DSI-1\"); \"\" = the first connected one."));
+    k.push_back(integer("display", "every_nth_frame", FIELD(display.everyNthFrame), 0, 1000000,
+                        "headless: write every N-th frame as a PNG into frames_dir (0 = none)."));
+    k.push_back(path("display", "frames_dir", FIELD(display.framesDir), "headless: where those frames go."));
+    k.push_back(text("display", "window_title", FIELD(display.windowTitle), "window: the window's title."));
+    // [screen]
+    k.push_back(enumChoice(
+        "screen", "language", FIELD(screen.language), {"en", "ja"}, [](Language l) { return languageCode(l); },
+        [](const std::string& s) { return parseLanguage(s); }, "The screens' language: \"en\" or \"ja\"."));
+    k.push_back(path("screen", "font_regular", FIELD(screen.fonts.regular),
+                     "Latin text; \"\" = DejaVu Sans (fonts-dejavu-core)."));
+    k.push_back(path("screen", "font_bold", FIELD(screen.fonts.bold),
+                     "Latin titles; \"\" = DejaVu Sans Bold (fonts-dejavu-core)."));
+    k.push_back(path("screen", "font_japanese", FIELD(screen.fonts.japanese),
+                     "Japanese text; \"\" = VL Gothic (fonts-vlgothic), else IPAGothic (fonts-ipafont-gothic)."));
+    k.push_back(path("screen", "strings_file", FIELD(screen.stringsFile),
+                     "The screens' strings; \"\" = the strings.toml the booth ships."));
+    k.push_back(flag("screen", "start_button_on_left", FIELD(screen.startButtonOnLeft),
+                     "The Start (keep) button is left of the Retake button, as the visitor sees them."));
+    // [flow]
+    k.push_back(seconds("flow", "countdown_s", FIELD(flow.countdown), 1.0, 10.0, "Countdown before each photo."));
+    k.push_back(seconds("flow", "steady_s", FIELD(flow.steadyOk), 0.0, 10.0,
+                        "The guide counts down by itself once its hint has said \"hold still\" this long."));
+    k.push_back(seconds("flow", "guide_absent_timeout_s", FIELD(flow.guideAbsentTimeout), 2.0, 600.0,
+                        "Back to the attract screen when nobody was seen this long in a guide."));
+    k.push_back(seconds("flow", "guide_max_time_s", FIELD(flow.guideMaxTime), 5.0, 3600.0,
+                        "Back to the attract screen after this long in a guide anyway."));
+    k.push_back(seconds("flow", "capture_timeout_s", FIELD(flow.captureTimeout), 1.0, 120.0,
+                        "No photo this long after the capture command: the capture failed (back to the guide)."));
+    k.push_back(seconds("flow", "processing_timeout_s", FIELD(flow.processingTimeout), 5.0, 600.0,
+                        "A fit still running after this long is cancelled and the session discarded."));
+    k.push_back(seconds("flow", "reveal_timeout_s", FIELD(flow.revealTimeout), 5.0, 3600.0,
+                        "The reveal waits this long for keep or retake; then the session is discarded (never kept "
+                        "unasked)."));
+    k.push_back(seconds("flow", "retake_choice_timeout_s", FIELD(flow.retakeChoiceTimeout), 2.0, 600.0,
+                        "The \"which photo?\" question goes back to the reveal after this long."));
+    k.push_back(seconds("flow", "thanks_time_s", FIELD(flow.thanksTime), 1.0, 600.0,
+                        "The thanks screen with the session's code is shown this long."));
+    k.push_back(seconds("flow", "thanks_min_time_s", FIELD(flow.thanksMinTime), 0.0, 600.0,
+                        "... and ignores the Start button this long, so the code is not skipped by the next visitor."));
+    k.push_back(seconds("flow", "camera_lost_timeout_s", FIELD(flow.cameraLostTimeout), 1.0, 3600.0,
+                        "A session whose camera was lost is given up after this long."));
+    k.push_back(seconds("flow", "press_guard_s", FIELD(flow.pressGuard), 0.0, 5.0,
+                        "Presses this soon after a screen changed are ignored (a double press does not act twice)."));
+    k.push_back(lockCombo());
+    k.push_back(seconds("flow", "lock_hold_s", FIELD(flow.lockHold), 1.0, 60.0,
+                        "How long lock_combo is held to open the operator menu."));
+    k.push_back(seconds("flow", "operator_timeout_s", FIELD(flow.operatorTimeout), 10.0, 3600.0,
+                        "The operator menu closes after this long without a press."));
+    // [guidance.oval]
+    k.push_back(number("guidance.oval", "centre_x", FIELD(guidance.oval.centreX), 0.1, 0.9,
+                       "The oval's centre, fraction of the frame's width."));
+    k.push_back(number("guidance.oval", "centre_y", FIELD(guidance.oval.centreY), 0.1, 0.9,
+                       "The oval's centre, fraction of the frame's height."));
+    k.push_back(number("guidance.oval", "height", FIELD(guidance.oval.height), 0.2, 1.0,
+                       "The head's outline (hair to chin), fraction of the frame's height."));
+    k.push_back(number("guidance.oval", "aspect", FIELD(guidance.oval.aspect), 0.4, 1.2, "The oval's width / height."));
+    // [sessions]
+    k.push_back(path("sessions", "directory", FIELD(sessions.directory),
+                     "Where kept sessions live, one folder per code (created readable by the booth's user only)."));
+    k.push_back(age<std::ratio<3600>>("sessions", "photo_retention_hours", FIELD(sessions.photoRetention), 0.0,
+                                      24.0 * 3650, "Photos are deleted this long after the session was kept (0 = never)."));
+    k.push_back(age<std::ratio<86400>>("sessions", "session_retention_days", FIELD(sessions.sessionRetention), 0.0,
+                                       3650.0, "The whole session is deleted this long after it was kept (0 = never)."));
+    k.push_back(integer("sessions", "code_length", FIELD(sessions.codeLength), 4, 12,
+                        "Characters in a session's code (the visitor's key to their avatar)."));
+    // [animation]
+    k.push_back(enumChoice(
+        "animation", "style", FIELD(animation.style), {"limited", "full"},
+        [](AnimationStyle s) { return animationStyleName(s); },
+        [](const std::string& s) { return s == "full" ? AnimationStyle::Full : AnimationStyle::Limited; },
+        "\"limited\" (Kitamura's limited animation) or \"full\" (every frame)."));
+    k.push_back(number("animation", "fps", FIELD(animation.fps), 1.0, 120.0, "Frames per second of the turn."));
+    k.push_back(integer("animation", "inbetween_omissions", FIELD(animation.inbetweenOmissions), 0, 100,
+                        "N_io: in-betweens omitted where the motion is fastest."));
+    k.push_back(number("animation", "hold_fraction", FIELD(animation.holdFraction), 0.0, 0.9,
+                       "N_hf: the share of the frames held."));
+    return k;
+}
+
+#undef FIELD
+#undef ELEMENT
+
+// ---- rendering -----------------------------------------------------------------------------------------------
+
+constexpr std::size_t kWidth = 116;  // the repository's line length
+
+std::string quoted(const std::string& s) {
+    std::string out = "\"";
+    for (const char ch : s) {
+        if (ch == '"' || ch == '\\') out += '\\';
+        out += ch;
+    }
+    return out + "\"";
+}
+
+// "# "-prefixed lines of at most kWidth characters.
+std::string comment(const std::string& text) {
+    std::string out, line;
+    std::istringstream words(text);
+    for (std::string w; words >> w;) {
+        if (!line.empty() && 2 + line.size() + 1 + w.size() > kWidth) {
+            out += "# " + line + "\n";
+            line.clear();
+        }
+        line += (line.empty() ? "" : " ") + w;
+    }
+    if (!line.empty()) out += "# " + line + "\n";
+    return out;
+}
+
+std::string bareOrQuoted(const std::string& key) {
+    const bool bare = !key.empty() && key.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                                            "0123456789_-") == std::string::npos;
+    return bare ? key : quoted(key);
+}
+
+std::vector<const ConfigKey*> keysOf(const std::string& table) {
+    std::vector<const ConfigKey*> keys;
+    for (const ConfigKey& k : configKeys())
+        if (k.table == table) keys.push_back(&k);
+    return keys;
+}
+
+std::string decimal(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+std::string typeName(ConfigType t) {
+    switch (t) {
+        case ConfigType::String: return "string";
+        case ConfigType::Path: return "path";
+        case ConfigType::Bool: return "bool";
+        case ConfigType::Integer: return "integer";
+        case ConfigType::Number: return "number";
+        case ConfigType::Seconds: return "seconds";
+        case ConfigType::Choice: return "choice";
+        case ConfigType::ButtonCombo: return "buttons";
+    }
+    return "?";
+}
+
+std::string allowed(const ConfigKey& k) {
+    switch (k.type) {
+        case ConfigType::Integer:
+            if (k.step > 1) {
+                std::string s;
+                for (auto v = static_cast<long long>(k.min); v <= static_cast<long long>(k.max); v += k.step)
+                    s += (s.empty() ? "" : ", ") + std::to_string(v);
+                return s;
+            }
+            return std::to_string(static_cast<long long>(k.min)) + " – " + std::to_string(static_cast<long long>(k.max));
+        case ConfigType::Number:
+        case ConfigType::Seconds: return decimal(k.min) + " – " + decimal(k.max);
+        case ConfigType::Choice: {
+            std::string s;
+            for (const auto& c : k.choices) s += (s.empty() ? "" : ", ") + std::string("`") + quoted(c) + "`";
+            return s;
+        }
+        case ConfigType::ButtonCombo: return "`start`, `retake`, `service` joined by `+`";
+        default: return "";
+    }
+}
+
+std::string cell(std::string s) {
+    std::string out;
+    for (const char ch : s) out += ch == '|' ? std::string("\\|") : std::string(1, ch);
+    return out;
+}
+
+}  // namespace
+
+const std::vector<ConfigTable>& configTables() {
+    static const std::vector<ConfigTable> tables = makeTables();
+    return tables;
+}
+
+const std::vector<ConfigKey>& configKeys() {
+    static const std::vector<ConfigKey> keys = makeKeys();
+    return keys;
+}
+
+std::string tomlValue(const ConfigValue& value) {
+    if (const bool* b = std::get_if<bool>(&value)) return *b ? "true" : "false";
+    if (const long long* i = std::get_if<long long>(&value)) return std::to_string(*i);
+    if (const std::string* s = std::get_if<std::string>(&value)) return quoted(*s);
+    // The shortest digits that read back as the same double, with a '.' so TOML reads a float.
+    char buffer[64];
+    const double d = std::get<double>(value);
+    const auto end = std::to_chars(buffer, buffer + sizeof buffer, d).ptr;
+    std::string s(buffer, end);
+    if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+    return s;
+}
+
+std::string renderDefaultConfig() {
+    const BoothConfig defaults;
+    std::string out =
+        comment("avatarbooth configuration: the reference of every key, each set to its default.") + "#\n" +
+        comment("Installed as /etc/avatarbooth/booth.toml; `avatarbooth run --config FILE` reads another. Every key "
+                "may be left out (the default below applies); an unknown key, a wrong type or a value out of range "
+                "stops the booth with the file, line and key named, so a typo never passes silently. "
+                "`avatarbooth config --check FILE` checks a file.") +
+        comment("Generated by `avatarbooth config --print-default` from app/config/config_schema.cpp.");
+    for (const ConfigTable& table : configTables()) {
+        const std::vector<const ConfigKey*> keys = keysOf(table.name);
+        switch (table.kind) {
+            case ConfigTableKind::Table:
+                out += "\n[" + table.name + "]\n" + comment(table.doc);
+                for (const ConfigKey* k : keys) out += comment(k->doc) + k->name + " = " + tomlValue(k->get(defaults, 0)) + "\n";
+                break;
+            case ConfigTableKind::Repeated: {
+                out += "\n" + comment(table.doc);
+                for (const ConfigKey* k : keys) out += comment(k->name + ": " + k->doc);
+                for (std::size_t i = 0; i < table.count(defaults); ++i) {
+                    out += (i ? "\n" : "") + std::string("[[") + table.name + "]]\n";
+                    for (const ConfigKey* k : keys) out += k->name + " = " + tomlValue(k->get(defaults, i)) + "\n";
+                }
+                break;
+            }
+            case ConfigTableKind::StringMap: {
+                out += "\n[" + table.name + "]\n" + comment(table.doc);
+                BoothConfig copy;
+                for (const auto& [key, value] : table.map(copy)) out += bareOrQuoted(key) + " = " + quoted(value) + "\n";
+                break;
+            }
+        }
+    }
+    return out;
+}
+
+std::string renderConfigReference() {
+    BoothConfig defaults;
+    std::string out;
+    for (const ConfigTable& table : configTables()) {
+        const bool repeated = table.kind == ConfigTableKind::Repeated;
+        out += std::string(out.empty() ? "" : "\n") + "**`" + (repeated ? "[[" : "[") + table.name +
+               (repeated ? "]]" : "]") + "`** " + table.doc + "\n";
+        const std::vector<const ConfigKey*> keys = keysOf(table.name);
+        if (table.kind == ConfigTableKind::StringMap) {
+            std::string lines, choices;
+            for (const auto& [key, value] : table.map(defaults))
+                lines += (lines.empty() ? "" : ", ") + std::string("`") + bareOrQuoted(key) + " = " + quoted(value) + "`";
+            for (const auto& c : table.valueChoices) choices += (choices.empty() ? "" : ", ") + std::string("`") + quoted(c) + "`";
+            out += "Default: " + lines + ". Values: " + choices + ".\n";
+            continue;
+        }
+        if (keys.empty()) continue;
+        out += "\n| key | type | default | allowed | meaning |\n|---|---|---|---|---|\n";
+        for (const ConfigKey* k : keys) {
+            std::string value;
+            const std::size_t n = repeated ? table.count(defaults) : 1;
+            for (std::size_t i = 0; i < n; ++i)
+                value += (i ? ", " : "") + std::string("`") + tomlValue(k->get(defaults, i)) + "`";
+            if (k->required) value = "required (" + value + ")";
+            out += "| `" + k->name + "` | " + typeName(k->type) + " | " + cell(value) + " | " + cell(allowed(*k)) + " | " +
+                   cell(k->doc) + " |\n";
+        }
+    }
+    return out;
+}
+
+}  // namespace avatarbooth
