@@ -203,7 +203,7 @@ std::string renderHtml(const nlohmann::json& summary, bool haveViewer) {
         const std::string glbJs = fileOf(s, "glb_js");
         if (ok && !glbJs.empty()) {
             h << "<model-viewer data-id=\"" << html(id) << "\" data-glb-js=\"" << html(url(glbJs))
-              << "\" camera-controls auto-rotate interaction-prompt=\"none\" alt=\"avatar of " << html(id)
+              << "\" loading=\"eager\" camera-controls auto-rotate interaction-prompt=\"none\" alt=\"avatar of " << html(id)
               << "\"></model-viewer><div class=\"viewer-state\"></div>"
               << "<small><a href=\"" << html(url(fileOf(s, "glb"))) << "\">avatar.glb</a> &middot; <a href=\""
               << html(url(fileOf(s, "session"))) << "/\">session folder</a></small>";
@@ -301,8 +301,7 @@ fs::path findModelViewer(const std::string& given) {
     std::error_code ec;
     const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
     if (!ec) places.push_back(exe.parent_path().parent_path() / "share" / "avatarbooth" / "model-viewer" / kViewerFile);
-    places.push_back(fs::path(__FILE__).parent_path().parent_path() / "assets" / "report" / "node_modules" / "@google" /
-                     "model-viewer" / "dist" / kViewerFile);
+    places.push_back(fs::path(AVATARBOOTH_MODEL_VIEWER_DIR) / kViewerFile);  // the source tree (npm)
     places.push_back(fs::path("/usr/share/avatarbooth/model-viewer") / kViewerFile);
     for (const auto& p : places)
         if (fs::is_regular_file(p, ec)) return p;

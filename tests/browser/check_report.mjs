@@ -37,9 +37,13 @@ try {
   findings.viewers = await page.$$eval('model-viewer', (all) => all.length);
   await page.evaluate(() => window.avatarboothLoadAll && window.avatarboothLoadAll());
   // Every viewer ends in data-state "loaded" or "error" (set by the report's own script from model-viewer's events).
-  await page.waitForFunction(
-    () => [...document.querySelectorAll('model-viewer')].every((el) => el.dataset.state === 'loaded' || el.dataset.state === 'error'),
-    { timeout: 90000, polling: 250 });
+  try {
+    await page.waitForFunction(
+      () => [...document.querySelectorAll('model-viewer')].every((el) => el.dataset.state === 'loaded' || el.dataset.state === 'error'),
+      { timeout: 120000, polling: 250 });
+  } catch (e) {
+    findings.consoleErrors.push(`viewers still loading after 120 s: ${e.message}`);
+  }
   const ids = await page.$$eval('model-viewer', (all) => all.map((el) => el.dataset.id));
   for (const id of ids) {
     const result = await page.evaluate(async (id) => {
