@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Set-up shared by the README's two commands: installs the Debian packages that are missing (as root, with
-# apt-get), installs the glTF validator from npm into tests/gltf/, and builds the project with CMake.
+# apt-get), installs from npm the glTF validator (tests/gltf/), the batch report's 3-D viewer (app/assets/report/)
+# and the browser driver of the report test (tests/browser/), and builds the project with CMake.
 # Usage: tests/setup.sh [PRESET]   (default: release; CI uses "ci", which turns warnings into errors)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -16,6 +17,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   systemd device-tree-compiler
   nodejs npm
+  # the batch report test opens report.html in headless Chromium (driven by puppeteer-core from npm)
+  chromium
   # the `kernel` tests (tests/kernel/): qemu boots Debian's kernel; busybox/cpio/kmod make its initramfs and
   # module tree (modules built with gcc-12/make); v4l-utils, udev, libcamera-ipa/-tools are used inside the guest
   qemu-system-x86 busybox-static cpio kmod xz-utils make gcc-12 libc6-dev v4l-utils udev libcamera-ipa libcamera-tools
@@ -40,6 +43,17 @@ fi
 if [ ! -d "$root/tests/gltf/node_modules/gltf-validator" ]; then
   echo "setup: installing the Khronos glTF validator (npm)"
   (cd "$root/tests/gltf" && npm ci --no-audit --no-fund --loglevel=error)
+fi
+
+# <model-viewer> for the 3-D views of `avatarbooth batch` reports (copied next to each report: no network at view
+# time), and puppeteer-core, which drives Debian's chromium in the report test (it downloads no browser).
+if [ ! -f "$root/app/assets/report/node_modules/@google/model-viewer/dist/model-viewer-umd.min.js" ]; then
+  echo "setup: installing model-viewer (npm)"
+  (cd "$root/app/assets/report" && npm ci --no-audit --no-fund --loglevel=error)
+fi
+if [ ! -d "$root/tests/browser/node_modules/puppeteer-core" ]; then
+  echo "setup: installing puppeteer-core (npm)"
+  (cd "$root/tests/browser" && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error)
 fi
 
 echo "setup: building ($preset)"

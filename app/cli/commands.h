@@ -7,6 +7,8 @@ namespace avatarbooth {
 
 // `avatarbooth fit`: a front + side photo pair to a textured head in an output folder.
 void registerFitCommand(CLI::App& app);
+// `avatarbooth batch`: many photo pairs (a folder of session folders or a CSV manifest) on N workers, with a report.
+void registerBatchCommand(CLI::App& app);
 // `avatarbooth make-base-head`: writes the built-in base head and its feature file, to study or edit.
 void registerMakeBaseHeadCommand(CLI::App& app);
 // `avatarbooth make-visitor`: writes a synthetic visitor's session folder (photos with known ground truth).

@@ -15,6 +15,8 @@ enum ExitCode : int {
     kExitBadConfig = 6,    // the configuration is invalid
     kExitOutput = 7,       // the output could not be written
     kExitDevice = 8,       // a camera, button line or display is missing, busy or went away
+    kExitSomeFailed = 9,   // `batch` finished, but some of its sessions failed (see its summary.json)
+    kExitInterrupted = 130,  // stopped by Ctrl-C (SIGINT), after keeping what was complete (shell convention 128+2)
 };
 
 inline int exitCodeFor(ErrorKind kind) {

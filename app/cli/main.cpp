@@ -14,9 +14,11 @@ int main(int argc, char** argv) {
     app.add_flag("-v,--verbose", verbose, "Log each stage as it runs");
     app.footer("Exit codes: 0 ok, 1 internal error, 2 usage, 3 bad input file, 4 no face found,\n"
                "            5 photos do not match, 6 bad config, 7 output not writable,\n"
-               "            8 device missing or busy (camera, buttons, display).");
+               "            8 device missing or busy (camera, buttons, display), 9 some batch sessions failed,\n"
+               "            130 interrupted (Ctrl-C).");
     avatarbooth::registerRunCommand(app);
     avatarbooth::registerFitCommand(app);
+    avatarbooth::registerBatchCommand(app);
     avatarbooth::registerMakeBaseHeadCommand(app);
     avatarbooth::registerToonCommand(app);
     avatarbooth::registerMakeVisitorCommand(app);

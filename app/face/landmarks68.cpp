@@ -15,14 +15,14 @@
 namespace avatarbooth {
 
 struct LandmarkDetector::Impl {
-    dlib::frontal_face_detector detector = dlib::get_frontal_face_detector();
-    dlib::shape_predictor predictor;
+    dlib::frontal_face_detector detector;
+    std::shared_ptr<const dlib::shape_predictor> predictor;
 
     // Face boxes in full-image pixels, largest first.
     std::vector<cv::Rect> faces(const cv::Mat& fullGrey);
     // The 68 points inside a face box.
     std::array<cv::Point2d, 68> landmarks(const cv::Mat& grey, const cv::Rect& face) {
-        const dlib::full_object_detection shape = predictor(
+        const dlib::full_object_detection shape = (*predictor)(
             dlib::cv_image<unsigned char>(grey), dlib::rectangle(face.x, face.y, face.x + face.width - 1, face.y + face.height - 1));
         std::array<cv::Point2d, 68> points{};
         for (unsigned k = 0; k < 68; ++k)
@@ -42,20 +42,32 @@ cv::Mat toGrey(const cv::Mat& bgr) {
 }  // namespace
 
 LandmarkDetector::LandmarkDetector(const std::filesystem::path& model) : impl_(std::make_unique<Impl>()) {
+    impl_->detector = dlib::get_frontal_face_detector();
     if (!std::filesystem::is_regular_file(model))
         throw BoothError(ErrorKind::BadConfig, model.string(),
                          "landmark model not found (install Debian's libdlib-data, or set [face] landmark_model)");
+    auto predictor = std::make_shared<dlib::shape_predictor>();
     try {
-        dlib::deserialize(model.string()) >> impl_->predictor;
+        dlib::deserialize(model.string()) >> *predictor;
     } catch (const std::exception& e) {
         throw BoothError(ErrorKind::BadConfig, model.string(), std::string("is not a dlib shape predictor: ") + e.what());
     }
-    if (impl_->predictor.num_parts() != 68)
+    if (predictor->num_parts() != 68)
         throw BoothError(ErrorKind::BadConfig, model.string(),
-                         "has " + std::to_string(impl_->predictor.num_parts()) + " landmarks, 68 expected");
+                         "has " + std::to_string(predictor->num_parts()) + " landmarks, 68 expected");
+    impl_->predictor = std::move(predictor);
 }
 
+LandmarkDetector::LandmarkDetector(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
 LandmarkDetector::~LandmarkDetector() = default;
+
+std::unique_ptr<LandmarkDetector> LandmarkDetector::sharingModel() const {
+    auto impl = std::make_unique<Impl>();
+    impl->detector = impl_->detector;  // a copy of the trained detector: cheaper than building it again (about 1 s)
+    impl->predictor = impl_->predictor;
+    return std::unique_ptr<LandmarkDetector>(new LandmarkDetector(std::move(impl)));
+}
 
 std::vector<cv::Rect> LandmarkDetector::Impl::faces(const cv::Mat& fullGrey) {
     // HOG detection costs grow with the pixel count; 640 px keeps a booth face (>= 150 px) well above dlib's

@@ -36,8 +36,14 @@ public:
     // The 68 points inside a given face box.
     std::array<cv::Point2d, 68> landmarksIn(const cv::Mat& bgr, const cv::Rect& face) const;
 
+    // A detector for another thread, sharing this one's loaded shape predictor (read-only after loading: dlib's
+    // shape_predictor::operator() is const) but with a face detector of its own: dlib's HOG detector builds its
+    // image pyramid inside itself while it runs, so one detector must not serve two threads at once.
+    std::unique_ptr<LandmarkDetector> sharingModel() const;
+
 private:
     struct Impl;
+    explicit LandmarkDetector(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> impl_;
 };
 

@@ -81,7 +81,15 @@ FitPipeline::FitPipeline(FitSettings settings, const BaseHead& base) : settings_
     modelLoadSeconds_ = secondsSince(t0);
 }
 
+FitPipeline::FitPipeline(const FitPipeline& shareFrom, std::unique_ptr<LandmarkDetector> detector)
+    : settings_(shareFrom.settings_), base_(shareFrom.base_), detector_(std::move(detector)),
+      modelLoadSeconds_(shareFrom.modelLoadSeconds_) {}
+
 FitPipeline::~FitPipeline() = default;
+
+std::unique_ptr<FitPipeline> FitPipeline::forAnotherThread() const {
+    return std::unique_ptr<FitPipeline>(new FitPipeline(*this, detector_->sharingModel()));
+}
 
 FitOutcome FitPipeline::fit(const FitInputs& inputs) const {
     const auto t0 = Clock::now();

@@ -63,6 +63,10 @@ public:
     // The loaded landmark detector, for the kiosk's preview guidance (not while a fit runs: one user at a time).
     const LandmarkDetector& detector() const { return *detector_; }
 
+    // Another pipeline for another thread (batch runs): shares the loaded landmark model, the base head and the
+    // texture tables, with a face detector of its own (see LandmarkDetector::sharingModel). Cheap: no loading.
+    std::unique_ptr<FitPipeline> forAnotherThread() const;
+
     // Reads, analyses, fits and textures. Errors are BoothErrors naming the photo they concern.
     FitOutcome fit(const FitInputs& inputs) const;
     // The same on photos already in memory (names are used in error messages).
@@ -75,6 +79,8 @@ public:
                                              const std::filesystem::path& out, MeshRenderer& renderer) const;
 
 private:
+    FitPipeline(const FitPipeline& shareFrom, std::unique_ptr<LandmarkDetector> detector);
+
     FitSettings settings_;
     const BaseHead& base_;
     std::unique_ptr<LandmarkDetector> detector_;
