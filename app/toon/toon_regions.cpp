@@ -287,11 +287,48 @@ ToonDrawing toonDrawing(const cv::Mat& photoBgr, const cv::Mat& headMask, int co
     cv::setRNGSeed(7);  // the same photo gives the same drawing
     cv::kmeans(samples, colours, clusterOf, cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 1.0),
                3, cv::KMEANS_PP_CENTERS, centres);
+    // Clusters that differ in lightness only (the same material lit differently: skin in light and in shade, hair
+    // with its sheen) become one: chroma (a, b) within kSameChroma and raw lightness within kSameLightness. Lips,
+    // eyes and hair differ in chroma or by much more lightness and stay apart. k-means alone cuts the skin, the
+    // largest area, into bands whatever the weights.
+    constexpr double kSameChroma = 6.0, kSameLightness = 40.0;
+    std::vector<int> merged(static_cast<std::size_t>(colours));
+    for (int k = 0; k < colours; ++k) merged[static_cast<std::size_t>(k)] = k;
+    std::vector<int> clusterSize(static_cast<std::size_t>(colours), 0);
+    for (int i = 0; i < samples.rows; ++i) ++clusterSize[static_cast<std::size_t>(clusterOf.at<int>(i))];
+    for (int a = 0; a < colours; ++a)
+        for (int b = a + 1; b < colours; ++b) {
+            const double dl = std::abs(centres.at<float>(a, 0) - centres.at<float>(b, 0)) / kLightnessWeight;
+            const double dc = std::hypot(centres.at<float>(a, 1) - centres.at<float>(b, 1),
+                                         centres.at<float>(a, 2) - centres.at<float>(b, 2));
+            if (dl > kSameLightness || dc > kSameChroma) continue;
+            const int ra = merged[static_cast<std::size_t>(a)], rb = merged[static_cast<std::size_t>(b)];
+            if (ra == rb) continue;
+            for (int& m : merged)
+                if (m == rb) m = ra;
+        }
+    {
+        // Merged centres: the size-weighted mean of their members.
+        cv::Mat joined(centres.size(), centres.type(), cv::Scalar(0));
+        std::vector<double> weight(static_cast<std::size_t>(colours), 0.0);
+        for (int k = 0; k < colours; ++k) {
+            const int m = merged[static_cast<std::size_t>(k)];
+            cv::Mat into = joined.row(m);
+            into += centres.row(k) * clusterSize[static_cast<std::size_t>(k)];
+            weight[static_cast<std::size_t>(m)] += clusterSize[static_cast<std::size_t>(k)];
+        }
+        for (int k = 0; k < colours; ++k)
+            if (weight[static_cast<std::size_t>(k)] > 0) {
+                cv::Mat row = joined.row(k);
+                row /= weight[static_cast<std::size_t>(k)];
+            }
+        centres = joined;
+    }
     cv::Mat index(photoBgr.size(), CV_8U, cv::Scalar(255));
     std::vector<cv::Vec3d> sum(static_cast<std::size_t>(colours), cv::Vec3d(0, 0, 0));
     std::vector<double> n(static_cast<std::size_t>(colours), 0.0);
     for (int i = 0; i < samples.rows; ++i) {
-        const int k = clusterOf.at<int>(i);
+        const int k = merged[static_cast<std::size_t>(clusterOf.at<int>(i))];
         const cv::Point p = inPixels[static_cast<std::size_t>(i)];
         index.at<uchar>(p) = static_cast<uchar>(k);
         const cv::Vec3b bgr = smooth.at<cv::Vec3b>(p);
