@@ -3,9 +3,8 @@
 
 #include "common/atomic_output.h"
 #include "common/image_io.h"
-#include "face/profile.h"
-#include "face/silhouette.h"
 #include "toon/toon_billboard.h"
+#include "toon/toon_correspondence.h"
 
 #include <algorithm>
 #include <iostream>
@@ -15,7 +14,7 @@ namespace avatarbooth {
 void registerToonCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand("toon", "Draw the visitor as a two-view toon and write a turntable strip of PNGs");
     struct Options {
-        std::string front, side, background, out;
+        std::string front, side, background, out, correspondence, writeCorrespondence;
         int frames = 24;
         int colours = 6;
     };
@@ -26,18 +25,18 @@ void registerToonCommand(CLI::App& app) {
     cmd->add_option("-o,--output", o->out, "Output folder")->required();
     cmd->add_option("--frames", o->frames, "Frames from -90 to 90 degrees")->check(CLI::Range(2, 720))->capture_default_str();
     cmd->add_option("--colours", o->colours, "Flat colours of the drawing")->check(CLI::Range(2, 16))->capture_default_str();
+    cmd->add_option("--correspondence", o->correspondence,
+                    "Region pairs and outline points to use (an edited --write-correspondence file)");
+    cmd->add_option("--write-correspondence", o->writeCorrespondence,
+                    "Write the region pairs and outline points used (editable text, app/toon/toon_correspondence.h)");
     cmd->callback([o] {
         const cv::Mat front = readPhoto(o->front), side = readPhoto(o->side);
         const cv::Mat plate = o->background.empty() ? cv::Mat() : readPhoto(o->background);
-        const SideAnalysis profile = analyzeSidePhoto(side, plate);
-        // Both photos come from the same camera at the same height: the side photo's chin row cuts both masks to
-        // the head.
-        const int chin = static_cast<int>(profilePoint(profile.landmarks, "chin").y) + 1;
-        cv::Mat frontMask = segmentPerson(front, plate), sideMask = profile.mask.clone();
-        frontMask.rowRange(std::clamp(chin, 0, frontMask.rows), frontMask.rows).setTo(0);
-        sideMask.rowRange(std::clamp(chin, 0, sideMask.rows), sideMask.rows).setTo(0);
-        const toon::ToonModel model =
-            toon::toonFromPhotos(front, frontMask, side, sideMask, profile.noseImageRight, o->colours);
+        toon::ToonModel model = toon::toonFromPhotoPair(front, side, plate, o->colours);
+        if (!o->correspondence.empty())
+            toon::applyCorrespondence(model, toon::loadCorrespondence(o->correspondence), o->correspondence);
+        if (!o->writeCorrespondence.empty())
+            writeFileAtomically(o->writeCorrespondence, toon::formatCorrespondence(model));
         StagedDirectory dir(o->out, "turntable_000.png");
         toon::writeTurntable(model, dir.staging(), o->frames, {400, 440}, 1.0);
         dir.commit();

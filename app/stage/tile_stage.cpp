@@ -16,6 +16,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <tuple>
 #include <sstream>
 
 namespace avatarbooth::stage {
@@ -151,6 +152,7 @@ struct Run {
     int column, first, last;  // rows of green, inclusive
     int brown = 0;            // its own brown run below (0: none, or a pond wall)
     bool pondWall = false;
+    bool rearFace = false;    // its brown continues as a face behind a nearer group (rear brown group rule)
 };
 
 }  // namespace
@@ -182,6 +184,38 @@ Stage buildStage(const TileMap& map) {
             }
             runs[static_cast<std::size_t>(g)].push_back(run);
         }
+    // Rear brown group (seed fig. 3.8): brown tiles form groups of their own (4-connected, cut by edge marks). A
+    // brown front is one flat face: a column whose brown is interrupted by the green of a nearer group, while the same
+    // brown group runs further down in other columns of the same plane (same group, same last green row), is that
+    // face seen above the nearer group, so it reaches as low as the rest of the face and does not sit on the nearer
+    // group. An edge mark that cuts the brown apart splits the face, and the cut part follows the stacking rule.
+    int brownCount = 0;
+    const std::vector<int> brownGroup = components(map, Tile::Brown, brownCount);
+    {
+        std::map<std::tuple<int, int, int>, int> lowest;  // (brown group, green group, last green row) -> lowest brown row
+        for (int g = 0; g < groupCount; ++g)
+            for (const Run& run : runs[static_cast<std::size_t>(g)]) {
+                if (run.pondWall || run.brown == 0) continue;
+                const int bottom = run.last + run.brown;
+                for (int b = run.last + 1; b <= bottom; ++b) {
+                    int& low = lowest.try_emplace({brownGroup[idx(run.column, b)], g, run.last}, bottom).first->second;
+                    low = std::max(low, bottom);
+                }
+            }
+        for (int g = 0; g < groupCount; ++g)
+            for (Run& run : runs[static_cast<std::size_t>(g)]) {
+                if (run.pondWall || run.brown == 0) continue;
+                const int bottom = run.last + run.brown;
+                const int below = groupAt(run.column, bottom + 1);
+                if (below < 0 || below == g) continue;
+                const auto it = lowest.find({brownGroup[idx(run.column, bottom)], g, run.last});
+                if (it != lowest.end() && it->second > bottom) {
+                    run.brown = it->second - run.last;
+                    run.rearFace = true;
+                }
+            }
+    }
+
     stage.groups.resize(static_cast<std::size_t>(groupCount));
     for (int g = 0; g < groupCount; ++g)
         for (const Run& run : runs[static_cast<std::size_t>(g)])
@@ -190,7 +224,7 @@ Stage buildStage(const TileMap& map) {
     // Stacking: a group whose brown front ends on another group's green sits on that group's top.
     for (int g = 0; g < groupCount; ++g)
         for (const Run& run : runs[static_cast<std::size_t>(g)]) {
-            if (run.pondWall || run.brown == 0) continue;
+            if (run.pondWall || run.brown == 0 || run.rearFace) continue;
             const int below = groupAt(run.column, run.last + run.brown + 1);
             if (below >= 0 && below != g) stage.groups[static_cast<std::size_t>(g)].sitsOn = below;
         }
@@ -207,8 +241,56 @@ Stage buildStage(const TileMap& map) {
     };
     for (int g = 0; g < groupCount; ++g) topOf(g);
 
-    // Occlusion completion: a gap between two runs of a group in one column, hidden by tiles of groups sitting on it,
-    // belongs to the group.
+    // Houses found before completion: a red group over a beige group; the green groups the walls stand on.
+    struct House {
+        int red = -1, beige = -1;
+        cv::Rect roof, body;
+    };
+    std::vector<House> houses;
+    int redCount = 0, beigeCount = 0;
+    const std::vector<int> red = components(map, Tile::Red, redCount);
+    const std::vector<int> beige = components(map, Tile::Beige, beigeCount);
+    auto bounds = [&](const std::vector<int>& ids, int id) {
+        cv::Rect box;
+        bool any = false;
+        for (int r = 0; r < h; ++r)
+            for (int c = 0; c < w; ++c)
+                if (ids[idx(c, r)] == id) {
+                    box = any ? (box | cv::Rect(c, r, 1, 1)) : cv::Rect(c, r, 1, 1);
+                    any = true;
+                }
+        return box;
+    };
+    // houseOn: for each red or beige tile of a house, the green group its walls stand on (-1: none).
+    std::vector<int> houseOn(static_cast<std::size_t>(w * h), -1);
+    for (int rr = 0; rr < redCount; ++rr) {
+        House house;
+        house.red = rr;
+        house.roof = bounds(red, rr);
+        for (int c = house.roof.x; c < house.roof.x + house.roof.width && house.beige < 0; ++c)
+            if (map.at(c, house.roof.y + house.roof.height) == Tile::Beige)
+                house.beige = beige[idx(c, house.roof.y + house.roof.height)];
+        if (house.beige < 0) continue;  // a roof with no walls under it is not a house
+        house.body = bounds(beige, house.beige);
+        int standsOn = -1;
+        for (int c = house.body.x; c < house.body.x + house.body.width; ++c) {
+            const int g = groupAt(c, house.body.y + house.body.height);
+            if (g >= 0 && (standsOn < 0 || stage.groups[static_cast<std::size_t>(g)].base +
+                                                   stage.groups[static_cast<std::size_t>(g)].height >
+                                               stage.groups[static_cast<std::size_t>(standsOn)].base +
+                                                   stage.groups[static_cast<std::size_t>(standsOn)].height))
+                standsOn = g;
+        }
+        for (int r = 0; r < h; ++r)
+            for (int c = 0; c < w; ++c)
+                if ((map.at(c, r) == Tile::Red && red[idx(c, r)] == rr) ||
+                    (map.at(c, r) == Tile::Beige && beige[idx(c, r)] == house.beige))
+                    houseOn[idx(c, r)] = standsOn;
+        houses.push_back(house);
+    }
+
+    // Occlusion completion: a gap between two runs of a group in one column, hidden by tiles of groups sitting on it
+    // or by a house standing on it (the ground goes on behind the house), belongs to the group.
     auto sitsOnGroup = [&](int other, int g) {
         for (int k = other; k >= 0; k = stage.groups[static_cast<std::size_t>(k)].sitsOn)
             if (stage.groups[static_cast<std::size_t>(k)].sitsOn == g) return true;
@@ -225,7 +307,7 @@ Stage buildStage(const TileMap& map) {
                 bool hidden = true;
                 for (int r = merged.back().last + 1; r < run.first && hidden; ++r) {
                     const int o = owner[idx(run.column, r)];
-                    hidden = o >= 0 && o != g && sitsOnGroup(o, g);
+                    hidden = (o >= 0 && o != g && sitsOnGroup(o, g)) || houseOn[idx(run.column, r)] == g;
                 }
                 if (hidden) {
                     merged.back().last = run.last;
@@ -278,9 +360,14 @@ Stage buildStage(const TileMap& map) {
                         depth = std::max(depth, d);
                         rFirstBrown = std::min(rFirstBrown, k + 1);
                     }
+                } else if (groupAt(c, r - 1) >= 0) {
+                    // Green straight above the water: a pond with no wall showing, i.e. no depth (the seed needs the
+                    // brown for a deep pond): water level with the ground, filling the hole the blue would leave.
+                    g = groupAt(c, r - 1);
+                    rFirstBrown = std::min(rFirstBrown, r);
                 }
             }
-        if (g < 0) continue;  // blue with no green-brown rim above: not a pond
+        if (g < 0) continue;  // blue with no green (or green-brown) rim above: not a pond
         const StageGroup& sg = stage.groups[static_cast<std::size_t>(g)];
         const double top = sg.base + sg.height;
         StageBox floor;
@@ -292,27 +379,8 @@ Stage buildStage(const TileMap& map) {
     }
 
     // Houses: a red run over a beige run; on green ground the house takes that group's top.
-    int redCount = 0, beigeCount = 0;
-    const std::vector<int> red = components(map, Tile::Red, redCount);
-    const std::vector<int> beige = components(map, Tile::Beige, beigeCount);
-    auto bounds = [&](const std::vector<int>& ids, int id) {
-        cv::Rect box;
-        bool any = false;
-        for (int r = 0; r < h; ++r)
-            for (int c = 0; c < w; ++c)
-                if (ids[idx(c, r)] == id) {
-                    box = any ? (box | cv::Rect(c, r, 1, 1)) : cv::Rect(c, r, 1, 1);
-                    any = true;
-                }
-        return box;
-    };
-    for (int rr = 0; rr < redCount; ++rr) {
-        const cv::Rect roof = bounds(red, rr);
-        int wall = -1;
-        for (int c = roof.x; c < roof.x + roof.width && wall < 0; ++c)
-            if (map.at(c, roof.y + roof.height) == Tile::Beige) wall = beige[idx(c, roof.y + roof.height)];
-        if (wall < 0) continue;  // a roof with no walls under it is not a house
-        const cv::Rect body = bounds(beige, wall);
+    for (const House& found : houses) {
+        const cv::Rect roof = found.roof, body = found.body;
         double base = 0.0;
         for (int c = body.x; c < body.x + body.width; ++c) {
             const int g = groupAt(c, body.y + body.height);

@@ -73,9 +73,12 @@ struct Stage {
 // The generation rules of METHODS §3.3 (rules the seed leaves open are decided and written in tile_stage.cpp):
 // groups of green tiles (edges cut them); per column, a box whose depth is its run of green tiles and whose own
 // height is the brown run below it; a group's top is at its highest box; a group whose brown front ends on another
-// group's green sits on it; tiles of a group sitting on this one that hide a gap in this one's columns are taken as
-// this one's (occlusion completion); green-brown-blue in a column is a pond as deep as its brown run; a red run over a
-// beige run is a house with a Nh_red / sqrt(2) roof.
+// group's green sits on it, unless that brown belongs to a brown group (brown tiles, cut by edges) that runs further
+// down in the same front plane: then it is the rear face seen above a nearer group and reaches as low as the rest;
+// tiles of a group sitting on this one, or of a house standing on it, that hide a gap in this one's columns are taken
+// as this one's (occlusion completion, ground behind houses); green-brown-blue in a column is a pond as deep as its
+// brown run, green-blue a pond level with the ground; a red run over a beige run is a house with a Nh_red / sqrt(2)
+// roof.
 Stage buildStage(const TileMap& map);
 
 // The stage as a triangle mesh in millimetres (`tileMm` per tile, centred on x and z, ground at y = 0), coloured

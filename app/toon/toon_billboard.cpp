@@ -4,6 +4,8 @@
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/image_io.h"
+#include "face/profile.h"
+#include "face/silhouette.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -102,8 +104,13 @@ ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const Dr
     return model;
 }
 
-cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel, int outlineWidth) {
-    cv::Mat canvas(size, CV_8UC3, cv::Scalar(255, 255, 255));
+namespace {
+
+// Draws the billboards into `canvas` (CV_8UC3, its size is the render size) and, when `alpha` is not null, their
+// coverage into *alpha (CV_8U, cleared by the caller).
+void drawToon(const ToonModel& model, double yawDeg, cv::Mat& canvas, cv::Mat* alpha, double unitsPerPixel,
+              int outlineWidth) {
+    const cv::Size size = canvas.size();
     const double yaw = std::clamp(std::abs(yawDeg), 0.0, 90.0);
     const double span = model.viewB.direction.thetaDeg - model.viewA.direction.thetaDeg;
     const double t = span != 0.0 ? std::clamp((yaw - model.viewA.direction.thetaDeg) / span, 0.0, 1.0) : 0.0;
@@ -147,13 +154,55 @@ cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double 
         }
         const cv::Vec3d rgb = (1.0 - t) * model.regionsA.regions[p.regionA].colour + t * model.regionsB.regions[p.regionB].colour;
         const cv::Scalar bgr(rgb[2] * 255.0, rgb[1] * 255.0, rgb[0] * 255.0);
-        cv::fillPoly(canvas, std::vector<std::vector<cv::Point>>{poly}, bgr, cv::LINE_AA, kShift);
-        if (outlineWidth > 0)
-            cv::polylines(canvas, std::vector<std::vector<cv::Point>>{poly}, true, cv::Scalar(20, 20, 20), outlineWidth,
-                          cv::LINE_AA, kShift);
+        const std::vector<std::vector<cv::Point>> polys{poly};
+        cv::fillPoly(canvas, polys, bgr, cv::LINE_AA, kShift);
+        if (outlineWidth > 0) cv::polylines(canvas, polys, true, cv::Scalar(20, 20, 20), outlineWidth, cv::LINE_AA, kShift);
+        if (alpha) {
+            cv::fillPoly(*alpha, polys, cv::Scalar(255), cv::LINE_AA, kShift);
+            if (outlineWidth > 0) cv::polylines(*alpha, polys, true, cv::Scalar(255), outlineWidth, cv::LINE_AA, kShift);
+        }
     }
-    if (yawDeg < 0.0) cv::flip(canvas, canvas, 1);  // the other side: the side drawing mirrored
+    if (yawDeg < 0.0) {  // the other side: the side drawing mirrored
+        cv::flip(canvas, canvas, 1);
+        if (alpha) cv::flip(*alpha, *alpha, 1);
+    }
+}
+
+}  // namespace
+
+cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel, int outlineWidth) {
+    cv::Mat canvas(size, CV_8UC3, cv::Scalar(255, 255, 255));
+    drawToon(model, yawDeg, canvas, nullptr, unitsPerPixel, outlineWidth);
     return canvas;
+}
+
+double toonRadius(const ToonModel& model) {
+    double radius = 0.0;
+    for (std::size_t k = 0; k < model.pairs.size(); ++k) {
+        double reachA = 0.0, reachB = 0.0;
+        for (const cv::Point2d& p : model.contours[k].a) reachA = std::max(reachA, cv::norm(p));
+        for (const cv::Point2d& p : model.contours[k].b) reachB = std::max(reachB, cv::norm(p));
+        radius = std::max({radius, glm::length(model.pairs[k].positionA) + reachA * model.viewA.unitsPerPixel,
+                           glm::length(model.pairs[k].positionB) + reachB * model.viewB.unitsPerPixel});
+    }
+    return radius;
+}
+
+cv::Mat renderToonBgra(const ToonModel& model, double yawDeg, cv::Size size, double radius, int outlineWidth) {
+    CV_Assert(size.width > 0 && size.height > 0);
+    if (radius <= 0.0) radius = toonRadius(model);
+    // Interpolated positions and outlines stay within the radius at every yaw (both ends do, and the renderer mixes
+    // them linearly), so the head never leaves the frame while it turns; 2 % spare for the outline's width.
+    const double unitsPerPixel = std::max(radius, 1e-9) * 2.0 * 1.02 / std::min(size.width, size.height);
+    // Dark under the coverage's soft edge: the edge is the dark outline, so straight alpha shows no light fringe.
+    cv::Mat canvas(size, CV_8UC3, cv::Scalar(20, 20, 20)), alpha(size, CV_8U, cv::Scalar(0));
+    drawToon(model, yawDeg, canvas, &alpha, unitsPerPixel, outlineWidth);
+    cv::Mat bgra;
+    cv::Mat channels[4];
+    cv::split(canvas, channels);
+    channels[3] = alpha;
+    cv::merge(channels, 4, bgra);
+    return bgra;
 }
 
 ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, const cv::Mat& sideBgr,
@@ -213,6 +262,16 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
     model.backdropPairs = 1;
     return model;
 }
+ToonModel toonFromPhotoPair(const cv::Mat& frontBgr, const cv::Mat& sideBgr, const cv::Mat& plate, int colours) {
+    const SideAnalysis profile = analyzeSidePhoto(sideBgr, plate);
+    // Both photos come from the same camera at the same height: the side photo's chin row cuts both masks to the head.
+    const int chin = static_cast<int>(profilePoint(profile.landmarks, "chin").y) + 1;
+    cv::Mat frontMask = segmentPerson(frontBgr, plate), sideMask = profile.mask.clone();
+    frontMask.rowRange(std::clamp(chin, 0, frontMask.rows), frontMask.rows).setTo(0);
+    sideMask.rowRange(std::clamp(chin, 0, sideMask.rows), sideMask.rows).setTo(0);
+    return toonFromPhotos(frontBgr, frontMask, sideBgr, sideMask, profile.noseImageRight, colours);
+}
+
 std::vector<std::filesystem::path> writeTurntable(const ToonModel& model, const std::filesystem::path& directory,
                                                   int frames, cv::Size size, double unitsPerPixel) {
     std::error_code ec;

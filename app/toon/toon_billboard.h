@@ -38,6 +38,14 @@ ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const Dr
 cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel,
                    int outlineWidth = 2);
 
+// The radius (character units) of a sphere round the origin that holds every billboard at every yaw: positions and
+// outline reaches at both views (the renderer interpolates between them linearly).
+double toonRadius(const ToonModel& model);
+// One frame for the kiosk: the toon head at `yawDeg` as BGRA (straight alpha = coverage, transparent around the head,
+// as Screens::avatar takes it), scaled so a sphere of `radius` (toonRadius(model) when <= 0; pass it in per frame
+// to skip that pass) fills the smaller side of `size`, so the head keeps its size and stays in frame while it turns.
+cv::Mat renderToonBgra(const ToonModel& model, double yawDeg, cv::Size size, double radius = 0.0, int outlineWidth = 2);
+
 // Builds a toon model from a front photo and a side photo with their head masks. The side photo may face either
 // way: `sideNoseImageRight` (SideAnalysis::noseImageRight) says which, and such a photo is mirrored so it looks at
 // the character's left side (theta 90). Both are cropped to their masks and scaled to `headHeightPx` pixels of
@@ -46,6 +54,13 @@ cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double 
 ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, const cv::Mat& sideBgr,
                          const cv::Mat& sideMask, bool sideNoseImageRight, int colours = 6,
                          int headHeightPx = 320);
+
+// The whole recipe from two photos (what `avatarbooth toon` and the kiosk use): the person's silhouette in each photo
+// (segmentPerson; the side one from analyzeSidePhoto, which also says which way it faces), both cut at the side
+// photo's chin row (same camera, same height) so the masks hold the head, then toonFromPhotos. `plate` (the empty
+// booth, optional) improves the silhouettes. Throws BoothError(NoFace) when the side profile or a mask is missing.
+ToonModel toonFromPhotoPair(const cv::Mat& frontBgr, const cv::Mat& sideBgr, const cv::Mat& plate = cv::Mat(),
+                            int colours = 6);
 
 // Writes `frames` PNGs (turntable_000.png …) sweeping the yaw from -90 to 90 degrees into `directory`
 // (created if missing), each file atomically; returns the paths.

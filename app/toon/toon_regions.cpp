@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <numbers>
 
 namespace avatarbooth::toon {
@@ -157,38 +158,189 @@ Regions splitRegions(const cv::Mat& drawingBgr, const cv::Mat& mask, const cv::M
     return out;
 }
 
+namespace {
+
+// Merges every 4-connected patch of `index` (cluster numbers, 255 outside the mask) smaller than `minArea` into the
+// touching patch whose cluster colour (`centres`, Lab rows) is closest, smallest patches first, so what remains are
+// patches of at least minArea (or patches with no neighbour). Region-adjacency merging with union-find.
+void mergeSmallPatches(cv::Mat& index, const cv::Mat& centres, int minArea) {
+    const int rows = index.rows, cols = index.cols;
+    cv::Mat patch(rows, cols, CV_32S, cv::Scalar(-1));
+    std::vector<int> cluster, area;
+    std::vector<cv::Point> stack;
+    for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c) {
+            const uchar k = index.at<uchar>(r, c);
+            if (k == 255 || patch.at<int>(r, c) >= 0) continue;
+            const int id = static_cast<int>(cluster.size());
+            int n = 0;
+            stack.assign(1, {c, r});
+            patch.at<int>(r, c) = id;
+            while (!stack.empty()) {
+                const cv::Point p = stack.back();
+                stack.pop_back();
+                ++n;
+                const cv::Point next[4] = {{p.x + 1, p.y}, {p.x - 1, p.y}, {p.x, p.y + 1}, {p.x, p.y - 1}};
+                for (const cv::Point& q : next) {
+                    if (q.x < 0 || q.y < 0 || q.x >= cols || q.y >= rows) continue;
+                    if (index.at<uchar>(q) != k || patch.at<int>(q) >= 0) continue;
+                    patch.at<int>(q) = id;
+                    stack.push_back(q);
+                }
+            }
+            cluster.push_back(k);
+            area.push_back(n);
+        }
+    const std::size_t count = cluster.size();
+    std::vector<std::vector<int>> neighbours(count);
+    auto link = [&](int a, int b) {
+        if (a < 0 || b < 0 || a == b) return;
+        neighbours[static_cast<std::size_t>(a)].push_back(b);
+        neighbours[static_cast<std::size_t>(b)].push_back(a);
+    };
+    for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c) {
+            const int a = patch.at<int>(r, c);
+            if (c + 1 < cols) link(a, patch.at<int>(r, c + 1));
+            if (r + 1 < rows) link(a, patch.at<int>(r + 1, c));
+        }
+    std::vector<int> parent(count);
+    for (std::size_t i = 0; i < count; ++i) parent[i] = static_cast<int>(i);
+    std::function<int(int)> root = [&](int x) {
+        while (parent[static_cast<std::size_t>(x)] != x) x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+        return x;
+    };
+    auto colourDistance = [&](int ka, int kb) { return cv::norm(centres.row(ka), centres.row(kb), cv::NORM_L2SQR); };
+    // Smallest first; a merged patch's area grows, so recheck until none is small (bounded: each merge removes one).
+    for (bool merged = true; merged;) {
+        merged = false;
+        std::vector<int> order;
+        for (std::size_t i = 0; i < count; ++i)
+            if (root(static_cast<int>(i)) == static_cast<int>(i) && area[i] < minArea) order.push_back(static_cast<int>(i));
+        std::sort(order.begin(), order.end(), [&](int a, int b) { return area[static_cast<std::size_t>(a)] < area[static_cast<std::size_t>(b)]; });
+        for (int p : order) {
+            if (root(p) != p || area[static_cast<std::size_t>(p)] >= minArea) continue;
+            int best = -1;
+            double bestDistance = 0.0;
+            for (int q : neighbours[static_cast<std::size_t>(p)]) {
+                const int rq = root(q);
+                if (rq == p) continue;
+                const double d = colourDistance(cluster[static_cast<std::size_t>(p)], cluster[static_cast<std::size_t>(rq)]);
+                if (best < 0 || d < bestDistance || (d == bestDistance && area[static_cast<std::size_t>(rq)] > area[static_cast<std::size_t>(best)])) {
+                    best = rq;
+                    bestDistance = d;
+                }
+            }
+            if (best < 0) continue;
+            parent[static_cast<std::size_t>(p)] = best;
+            area[static_cast<std::size_t>(best)] += area[static_cast<std::size_t>(p)];
+            auto& into = neighbours[static_cast<std::size_t>(best)];
+            const auto& from = neighbours[static_cast<std::size_t>(p)];
+            into.insert(into.end(), from.begin(), from.end());
+            // Keep the lists short: roots only, once each.
+            for (int& q : into) q = root(q);
+            std::sort(into.begin(), into.end());
+            into.erase(std::unique(into.begin(), into.end()), into.end());
+            merged = true;
+        }
+    }
+    for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c) {
+            const int a = patch.at<int>(r, c);
+            if (a >= 0) index.at<uchar>(r, c) = static_cast<uchar>(cluster[static_cast<std::size_t>(root(a))]);
+        }
+}
+
+}  // namespace
+
 ToonDrawing toonDrawing(const cv::Mat& photoBgr, const cv::Mat& headMask, int colours, int outlineWidth) {
     CV_Assert(photoBgr.type() == CV_8UC3 && headMask.size() == photoBgr.size());
     ToonDrawing out;
     out.mask = headMask > 127;
-    // Smooth within edges first so quantisation gives large flat patches, not speckle.
-    cv::Mat smooth;
-    cv::bilateralFilter(photoBgr, smooth, 9, 40.0, 7.0);
-    std::vector<cv::Point> inPixels;
-    cv::findNonZero(out.mask, inPixels);
     out.bgr = cv::Mat(photoBgr.size(), CV_8UC3, cv::Scalar(255, 255, 255));
     out.outline = cv::Mat(photoBgr.size(), CV_8U, cv::Scalar(0));
+    std::vector<cv::Point> inPixels;
+    cv::findNonZero(out.mask, inPixels);
     if (static_cast<int>(inPixels.size()) < colours) return out;
+    // Sizes follow the head: the mask's height (photos come scaled to ~320 px of head, but any size works).
+    const cv::Rect head = cv::boundingRect(out.mask);
+    const double unit = head.height / 320.0;
+    // Mean shift flattens skin shading and pores into patches while keeping the edges of eyes, brows and hair; a
+    // bilateral pass then evens what is left. (Bilateral alone left shading bands that k-means cut into many patches.)
+    cv::Mat smooth, shifted;
+    cv::pyrMeanShiftFiltering(photoBgr, shifted, std::max(4.0, 8.0 * unit), 20.0, 1);
+    cv::bilateralFilter(shifted, smooth, 7, 30.0, 5.0);
+    // k-means in Lab with the lightness weighted down: shading changes lightness much more than hue, so the skin stays
+    // one cluster under the booth's side light while hair, eyes, lips and brows (different chroma or much darker)
+    // keep theirs.
+    cv::Mat lab;
+    cv::cvtColor(smooth, lab, cv::COLOR_BGR2Lab);
+    constexpr float kLightnessWeight = 0.5f;
     cv::Mat samples(static_cast<int>(inPixels.size()), 3, CV_32F);
     for (int i = 0; i < samples.rows; ++i) {
-        const cv::Vec3b p = smooth.at<cv::Vec3b>(inPixels[static_cast<std::size_t>(i)]);
-        for (int k = 0; k < 3; ++k) samples.at<float>(i, k) = p[k];
+        const cv::Vec3b p = lab.at<cv::Vec3b>(inPixels[static_cast<std::size_t>(i)]);
+        samples.at<float>(i, 0) = p[0] * kLightnessWeight;
+        samples.at<float>(i, 1) = p[1];
+        samples.at<float>(i, 2) = p[2];
     }
     cv::Mat clusterOf, centres;
     cv::setRNGSeed(7);  // the same photo gives the same drawing
     cv::kmeans(samples, colours, clusterOf, cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 1.0),
                3, cv::KMEANS_PP_CENTERS, centres);
+    // Clusters that differ in lightness only (the same material lit differently: skin in light and in shade, hair
+    // with its sheen) become one: chroma (a, b) within kSameChroma and raw lightness within kSameLightness. Lips,
+    // eyes and hair differ in chroma or by much more lightness and stay apart. k-means alone cuts the skin, the
+    // largest area, into bands whatever the weights.
+    constexpr double kSameChroma = 6.0, kSameLightness = 40.0;
+    std::vector<int> merged(static_cast<std::size_t>(colours));
+    for (int k = 0; k < colours; ++k) merged[static_cast<std::size_t>(k)] = k;
+    std::vector<int> clusterSize(static_cast<std::size_t>(colours), 0);
+    for (int i = 0; i < samples.rows; ++i) ++clusterSize[static_cast<std::size_t>(clusterOf.at<int>(i))];
+    for (int a = 0; a < colours; ++a)
+        for (int b = a + 1; b < colours; ++b) {
+            const double dl = std::abs(centres.at<float>(a, 0) - centres.at<float>(b, 0)) / kLightnessWeight;
+            const double dc = std::hypot(centres.at<float>(a, 1) - centres.at<float>(b, 1),
+                                         centres.at<float>(a, 2) - centres.at<float>(b, 2));
+            if (dl > kSameLightness || dc > kSameChroma) continue;
+            const int ra = merged[static_cast<std::size_t>(a)], rb = merged[static_cast<std::size_t>(b)];
+            if (ra == rb) continue;
+            for (int& m : merged)
+                if (m == rb) m = ra;
+        }
+    {
+        // Merged centres: the size-weighted mean of their members.
+        cv::Mat joined(centres.size(), centres.type(), cv::Scalar(0));
+        std::vector<double> weight(static_cast<std::size_t>(colours), 0.0);
+        for (int k = 0; k < colours; ++k) {
+            const int m = merged[static_cast<std::size_t>(k)];
+            cv::Mat into = joined.row(m);
+            into += centres.row(k) * clusterSize[static_cast<std::size_t>(k)];
+            weight[static_cast<std::size_t>(m)] += clusterSize[static_cast<std::size_t>(k)];
+        }
+        for (int k = 0; k < colours; ++k)
+            if (weight[static_cast<std::size_t>(k)] > 0) {
+                cv::Mat row = joined.row(k);
+                row /= weight[static_cast<std::size_t>(k)];
+            }
+        centres = joined;
+    }
     cv::Mat index(photoBgr.size(), CV_8U, cv::Scalar(255));
+    std::vector<cv::Vec3d> sum(static_cast<std::size_t>(colours), cv::Vec3d(0, 0, 0));
+    std::vector<double> n(static_cast<std::size_t>(colours), 0.0);
     for (int i = 0; i < samples.rows; ++i) {
-        const int k = clusterOf.at<int>(i);
+        const int k = merged[static_cast<std::size_t>(clusterOf.at<int>(i))];
         const cv::Point p = inPixels[static_cast<std::size_t>(i)];
         index.at<uchar>(p) = static_cast<uchar>(k);
-        out.bgr.at<cv::Vec3b>(p) = cv::Vec3b(cv::saturate_cast<uchar>(centres.at<float>(k, 0)),
-                                             cv::saturate_cast<uchar>(centres.at<float>(k, 1)),
-                                             cv::saturate_cast<uchar>(centres.at<float>(k, 2)));
+        const cv::Vec3b bgr = smooth.at<cv::Vec3b>(p);
+        sum[static_cast<std::size_t>(k)] += cv::Vec3d(bgr[0], bgr[1], bgr[2]);
+        n[static_cast<std::size_t>(k)] += 1.0;
     }
     cv::medianBlur(index, index, 5);  // removes single-pixel islands between clusters
-    // Edges: where the quantised colour changes, and the head's own boundary.
+    index.setTo(255, ~out.mask);
+    // Patches under 1/400 of the head height squared (a 16 px square at 320 px: an eye's parts) go to the touching
+    // patch of the nearest colour, so every region left is a face part, not a shading fleck.
+    mergeSmallPatches(index, centres, std::max(30, cvRound(head.height * head.height / 400.0)));
+    // Edges: where the patch colour changes, and the head's own boundary.
     cv::Mat edges(photoBgr.size(), CV_8U, cv::Scalar(0));
     for (int r = 0; r + 1 < index.rows; ++r)
         for (int c = 0; c + 1 < index.cols; ++c) {
@@ -206,9 +358,10 @@ ToonDrawing toonDrawing(const cv::Mat& photoBgr, const cv::Mat& headMask, int co
             if (out.outline.at<uchar>(r, c)) {
                 out.bgr.at<cv::Vec3b>(r, c) = cv::Vec3b(0, 0, 0);
             } else if (k != 255) {
-                out.bgr.at<cv::Vec3b>(r, c) = cv::Vec3b(cv::saturate_cast<uchar>(centres.at<float>(k, 0)),
-                                                        cv::saturate_cast<uchar>(centres.at<float>(k, 1)),
-                                                        cv::saturate_cast<uchar>(centres.at<float>(k, 2)));
+                // The cluster's mean photo colour (the Lab centre is weighted, so it is not a colour to show).
+                const cv::Vec3d m = sum[k] / std::max(1.0, n[k]);
+                out.bgr.at<cv::Vec3b>(r, c) = cv::Vec3b(cv::saturate_cast<uchar>(m[0]), cv::saturate_cast<uchar>(m[1]),
+                                                        cv::saturate_cast<uchar>(m[2]));
             }
         }
     return out;

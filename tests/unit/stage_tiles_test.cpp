@@ -109,6 +109,57 @@ TEST(StageRules, EdgesMakeACubeOnASlabAndTheHiddenSlabIsCompleted) {
     EXPECT_EQ(cube.groups[1].sitsOn, 0);
 }
 
+TEST(StageRules, RearBrownFaceSeenAboveANearerGroupReachesTheGroundUnlessAnEdgeCutsIt) {
+    // A slab 2 high (rows 0-1 green, its front rows 2-3) with a cube 1 high in front of its middle (row 3 green, row
+    // 4 its front). Columns 1-2 of the slab show one brown row and then the cube's green; the slab's brown group runs
+    // on to row 3 in columns 0 and 3, so it is one face standing on the ground behind the cube.
+    const Stage s = buildStage(parseTileMap("gggg\ngggg\nbbbb\nbggb\n.bb.\n"));
+    ASSERT_EQ(s.groups.size(), 2u);
+    EXPECT_EQ(s.groups[0].sitsOn, -1);
+    EXPECT_EQ(s.groups[0].height, 2);
+    EXPECT_EQ(s.groups[1].sitsOn, -1);
+    const std::vector<StageBox> expected{ground(0, {0, 0, 2}, {4, 2, 4}), ground(1, {1, 0, 4}, {3, 1, 5})};
+    EXPECT_EQ(s.boxes, expected) << describe(s.boxes);
+    // Edge marks cut columns 1-2 of that brown row from the rest: their face ends on the cube's green, so (the
+    // stacking rule) the slab sits on the cube: top 1 + 2 = 3, columns 0 and 3 keep their 2-tile front, 1-2 their 1.
+    const Stage cut = buildStage(parseTileMap("gggg\ngggg\nb|bb|b\nbggb\n.bb.\n"));
+    ASSERT_EQ(cut.groups.size(), 2u);
+    EXPECT_EQ(cut.groups[0].sitsOn, 1);
+    EXPECT_EQ(cut.groups[0].base, 1.0);
+    const std::vector<StageBox> stacked{ground(0, {0, 1, 3}, {1, 3, 5}), ground(0, {1, 2, 3}, {3, 3, 5}),
+                                        ground(0, {3, 1, 3}, {4, 3, 5}), ground(1, {1, 0, 4}, {3, 1, 5})};
+    EXPECT_EQ(cut.boxes, stacked) << describe(cut.boxes);
+}
+
+TEST(StageRules, GroundBehindAHouseIsCompleted) {
+    // A house in the middle of a green field: the field's columns 1-3 show green above the roof and below the walls;
+    // the ground goes on behind the house, so the field is one whole slab, the house on it.
+    const Stage s = buildStage(parseTileMap("ggggg\ngrrrg\ngrrrg\ngeeeg\ngeeeg\nggggg\nbbbbb\n"));
+    ASSERT_EQ(s.groups.size(), 1u);
+    EXPECT_EQ(s.groups[0].height, 1);
+    const std::vector<StageBox> expected{ground(0, {0, 0, 1}, {5, 1, 7}),
+                                         box(StageBox::Kind::House, -1, {1, 1, 4}, {4, 3, 6})};
+    EXPECT_EQ(s.boxes, expected) << describe(s.boxes);
+    ASSERT_EQ(s.roofs.size(), 1u);
+    EXPECT_EQ(s.roofs[0].min, glm::dvec3(1, 3, 4));
+    EXPECT_DOUBLE_EQ(s.roofs[0].max.y, 3 + 2 / std::sqrt(2.0));
+    // A house standing on the ground (no green under its walls) completes nothing: the gap behind it stays.
+    const Stage apart = buildStage(parseTileMap("ggg\nrrr\neee\n"));
+    const std::vector<StageBox> noFill{ground(0, {0, 0, 0}, {3, 0, 1}),
+                                       box(StageBox::Kind::House, -1, {0, 0, 2}, {3, 1, 3})};
+    EXPECT_EQ(apart.boxes, noFill) << describe(apart.boxes);
+}
+
+TEST(StageRules, PondWithNoBrownWallIsWaterLevelWithTheGround) {
+    // Green, blue, green: no brown wall shows, so no depth: the water fills the hole at the ground's top.
+    const Stage s = buildStage(parseTileMap("ggg\ngwg\nggg\nbbb\n"));
+    ASSERT_EQ(s.groups.size(), 1u);
+    const std::vector<StageBox> expected{ground(0, {0, 0, 1}, {1, 1, 4}), ground(0, {1, 0, 1}, {2, 1, 2}),
+                                         ground(0, {1, 0, 3}, {2, 1, 4}), ground(0, {2, 0, 1}, {3, 1, 4}),
+                                         box(StageBox::Kind::PondFloor, 0, {1, 0, 2}, {2, 1, 3})};
+    EXPECT_EQ(s.boxes, expected) << describe(s.boxes);
+}
+
 TEST(StageRules, PondDigsAsDeepAsItsBrownRun) {
     const Stage s = buildStage(parseTileMap("ggg\ngbg\ngwg\nggg\nbbb\nbbb\n"));
     ASSERT_EQ(s.groups.size(), 1u);
