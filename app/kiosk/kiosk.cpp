@@ -257,7 +257,8 @@ private:
     };
 
     static void load(State& s, const FitSettings& settings) {
-        lowerThisThreadsPriority(10);  // a one-off; the attract screen and the guides run meanwhile
+        // (Not niced: nice is weighed against every process on the machine, and a model that loads minutes late keeps
+        // a visitor on the processing screen; the main loop never waits for it anyway.)
         std::unique_ptr<FitPipeline> loaded;
         std::optional<std::string> error;
         try {
