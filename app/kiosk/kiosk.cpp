@@ -501,13 +501,15 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
-void writeScreenshot(const fs::path& dir, int index, ScreenId id, const cv::Mat& frame, KioskReport& report) {
+// replace: the screen's picture again, over the one written before under this index.
+void writeScreenshot(const fs::path& dir, int index, ScreenId id, const cv::Mat& frame, KioskReport& report,
+                     bool replace = false) {
     char name[64];
     std::snprintf(name, sizeof name, "%02d_%s.png", index, toString(id));
     const fs::path path = dir / name;
     try {
         writeFileAtomically(path, encodeImage(frame, ".png"));
-        report.screenshots.push_back(path);
+        if (!replace) report.screenshots.push_back(path);
     } catch (const BoothError& e) {
         spdlog::warn("screenshot not written: {}", e.what());
     }
@@ -585,6 +587,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     Hint lastHint = Hint::None;
     bool screenshotDue = !options.screenshots.empty();
     int screenshotIndex = 0;
+    int hintlessGuideShot = -1;  // the index of a guide's screenshot taken before its first hint was known
     std::vector<std::pair<Button, FlowTime>> releases;  // simulated presses to release
     auto lastRetention = std::chrono::steady_clock::now();
     // Benchmark figures.
@@ -835,19 +838,25 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
         if (screen.id != lastScreen) {
             screenshotDue = !options.screenshots.empty();
+            hintlessGuideShot = -1;
         }
-        // A screen's picture once it has what it shows: the preview on guides (and a guide's first hint, which
-        // waits for the first analysis: slow on a slow board), the avatar on the reveal.
+        // A screen's picture once it has what it shows: the preview on guides, the avatar on the reveal. A guide
+        // whose first hint was not known yet (the first analysis is slow on a slow board) is taken again, under the
+        // same name, once it is.
         const bool guide = screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide;
         if (guide && (screen.id != lastScreen || screen.hint != lastHint))
             spdlog::info("{}: hint {}", toString(screen.id), toString(screen.hint));
         lastHint = screen.hint;
+        if (hintlessGuideShot >= 0 && screen.hint != Hint::None) {
+            writeScreenshot(options.screenshots, hintlessGuideShot, screen.id, drawn, report, true);
+            hintlessGuideShot = -1;
+        }
         const bool complete = (!previewScreen || (!inputs.preview.empty() && screen.sinceEntered >= Millis(700))) &&
-                              (!guide || screen.hint != Hint::None) &&
                               (screen.id != ScreenId::Reveal || !inputs.avatar.empty()) &&
                               (screen.id != ScreenId::Thanks || !screen.code.empty());
         lastScreen = screen.id;
         if (screenshotDue && complete) {
+            if (guide && screen.hint == Hint::None) hintlessGuideShot = screenshotIndex;
             writeScreenshot(options.screenshots, screenshotIndex++, screen.id, drawn, report);
             screenshotDue = false;
         }

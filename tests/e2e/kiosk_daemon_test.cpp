@@ -108,6 +108,9 @@ TEST(KioskDaemon, GuideSaysNoFaceKeepsPingingAndStopsPromptlyWhileTheModelIsStil
                                exited);
     if (!guide) kill9();
     ASSERT_TRUE(guide) << "no front guide screenshot\n" << readText(log);
+    // The first analysis's hint (the screenshot is taken again with it when it came later than the picture).
+    waitFor([&] { return readText(log).find("front_guide: hint no_face") != std::string::npos; }, 30s, notify, pid,
+            status, exited);
 
     // In the guide: pings every 600 ms for 3 s (no gap as long as the 1.2 s the watchdog allows).
     const auto from = std::chrono::steady_clock::now();
