@@ -1,5 +1,6 @@
 // `avatarbooth run [--config booth.toml] [--sessions N] [--screenshots DIR]`: the kiosk.
 #include "cli/commands.h"
+#include "cli/exit_codes.h"
 
 #include "common/error.h"
 #include "config/booth_config.h"
@@ -26,6 +27,18 @@ namespace fs = std::filesystem;
 
 std::atomic<bool> stopRequested{false};
 extern "C" void onStopSignal(int) { stopRequested.store(true); }
+
+// Ends the process while the kiosk's model-loading thread is still running (stopped during start-up): the output
+// flushed, then std::quick_exit, which runs no static destructors -- the load still reads the built-in base head and
+// the texture's static caches, which exit() would destroy under it. Nothing else needs tearing down: the kiosk has
+// already closed the devices and discarded an unfinished session.
+[[noreturn]] void endLeavingTheModelLoad(int code) {
+    spdlog::default_logger()->flush();
+    std::cout.flush();
+    std::cerr.flush();
+    std::fflush(nullptr);
+    std::quick_exit(code);
+}
 
 constexpr const char* kInstalledConfig = "/etc/avatarbooth/booth.toml";
 
@@ -111,7 +124,15 @@ void registerRunCommand(CLI::App& app) {
         options.screenshots = o->screenshots;
         options.visitor = visitor ? &simVisitor : nullptr;
         options.stop = &stopRequested;
-        const KioskReport report = runKiosk(config, options);
+        KioskReport report;
+        try {
+            report = runKiosk(config, options);
+        } catch (const std::exception& e) {
+            if (!kioskLeftAThreadRunning()) throw;
+            const auto* booth = dynamic_cast<const BoothError*>(&e);
+            std::cerr << "avatarbooth: " << (booth ? "error: " : "internal error: ") << e.what() << "\n";
+            endLeavingTheModelLoad(booth ? exitCodeFor(booth->kind()) : kExitInternal);
+        }
 
         std::cout << report.sessionsEnded << " visitor session(s); kept:";
         for (const auto& code : report.keptCodes) std::cout << " " << code;
@@ -128,6 +149,7 @@ void registerRunCommand(CLI::App& app) {
                     report.sideCaptureToRevealSeconds, report.revealFrameMilliseconds,
                     report.revealFrameMilliseconds > 0.0 ? 1000.0 / report.revealFrameMilliseconds : 0.0,
                     report.peakRssMegabytes);
+        if (kioskLeftAThreadRunning()) endLeavingTheModelLoad(kExitOk);
     });
 }
 

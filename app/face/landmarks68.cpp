@@ -43,7 +43,9 @@ cv::Mat toGrey(const cv::Mat& bgr) {
 
 LandmarkDetector::LandmarkDetector(const std::filesystem::path& model) : impl_(std::make_unique<Impl>()) {
     impl_->detector = dlib::get_frontal_face_detector();
-    if (!std::filesystem::is_regular_file(model))
+    // Any readable file that is not a folder: a named pipe too (the kiosk's tests feed a model slowly, or never,
+    // through one, to check that the booth does not wait for the load).
+    if (!std::filesystem::exists(model) || std::filesystem::is_directory(model))
         throw BoothError(ErrorKind::BadConfig, model.string(),
                          "landmark model not found (install Debian's libdlib-data, or set [face] landmark_model)");
     auto predictor = std::make_shared<dlib::shape_predictor>();

@@ -23,18 +23,22 @@
 #include <systemd/sd-daemon.h>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cerrno>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <cstring>
 #include <deque>
 #include <functional>
 #include <mutex>
 #include <random>
+#include <thread>
 
 #include <sys/resource.h>
-#include <thread>
+#include <unistd.h>
 
 namespace avatarbooth {
 namespace {
@@ -45,7 +49,6 @@ using Seconds = std::chrono::duration<double>;
 constexpr auto kFramePeriod = std::chrono::microseconds(33333);  // the screen's 30 fps
 constexpr auto kReleaseAfter = std::chrono::milliseconds(120);    // a simulated press lasts this long
 constexpr auto kRetentionEvery = std::chrono::minutes(10);
-constexpr auto kWatchdogEvery = std::chrono::seconds(1);
 
 // The fraction of the fit done when a stage starts (the stages' shares of the time measured by `bench`).
 double stageProgress(const std::string& stage) {
@@ -151,51 +154,80 @@ struct FitResult {
     std::optional<BoothError> error;
 };
 
-// Loads the landmark model, then fits one job at a time: its own thread, its own offscreen renderer (EGL contexts
-// belong to a thread).
+// Lowers the calling thread's priority (Linux: nice is per thread): the screen and the watchdog come first when
+// the cores are busy. Best effort: without it the booth still works, only its frame rate suffers under load.
+void lowerThisThreadsPriority(int nice) {
+    if (setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), nice) != 0)
+        spdlog::debug("setpriority({}): {}", nice, std::strerror(errno));
+}
+
+// Loads the landmark model on one thread, then fits one job at a time on another (with its own offscreen renderer:
+// EGL contexts belong to a thread). dlib's deserialisation cannot be interrupted (minutes on a slow board or under
+// emulation) and the booth must stop within systemd's TimeoutStopSec, so the loading thread is the one thread the
+// kiosk may leave running: everything it uses lives in the State it shares, and a worker destroyed while the model
+// is still loading detaches it instead of joining it (see ~FitWorker and kioskLeftAThreadRunning()).
 class FitWorker {
 public:
-    FitWorker(FitSettings settings, std::shared_ptr<const BaseHead> base, std::mutex& detectorMutex)
-        : settings_(std::move(settings)), base_(std::move(base)), detectorMutex_(detectorMutex),
-          thread_([this] { run(); }) {}
+    FitWorker(FitSettings settings, std::shared_ptr<const BaseHead> base, std::shared_ptr<std::mutex> detectorMutex)
+        : state_(std::make_shared<State>()) {
+        state_->detectorMutex = std::move(detectorMutex);
+        state_->base = std::move(base);  // the pipeline refers to it: it lives as long as the State
+        loader_ = std::thread([state = state_, settings = std::move(settings)] { load(*state, settings); });
+        fitter_ = std::thread([state = state_] { fit(*state); });
+    }
     ~FitWorker() {
+        bool loading = false;
         {
-            std::lock_guard lock(mutex_);
-            quit_ = true;
+            std::lock_guard lock(state_->mutex);
+            state_->quit = true;
+            loading = state_->loading;
         }
-        wake_.notify_all();
-        thread_.join();
+        state_->wake.notify_all();
+        fitter_.join();  // waiting for the model or a job: wakes at once (a fit in flight is finished first)
+        if (!loading) {
+            loader_.join();
+            return;
+        }
+        // Still inside the model's deserialisation: left to finish on its own. Once it does, it sees `quit` and
+        // drops the model without touching anything outside its State (no logging, no detector mutex). The process
+        // must then end without running static destructors (the load reads the built-in base head and fills the
+        // texture step's static caches): `avatarbooth run` ends with std::quick_exit when kioskLeftAThreadRunning().
+        spdlog::info("stopping while the landmark model is still loading: its thread is left to the process's exit");
+        threadLeftRunning.store(true);
+        loader_.detach();
     }
 
     // The pipeline once the model has loaded (null before); its error if loading failed.
     const FitPipeline* pipeline() const {
-        std::lock_guard lock(mutex_);
-        return pipeline_.get();
+        std::lock_guard lock(state_->mutex);
+        return state_->pipeline.get();
     }
     std::optional<std::string> loadError() const {
-        std::lock_guard lock(mutex_);
-        return loadError_;
+        std::lock_guard lock(state_->mutex);
+        return state_->loadError;
     }
 
     void submit(std::uint64_t job, cv::Mat front, cv::Mat side, fs::path out) {
         {
-            std::lock_guard lock(mutex_);
-            job_ = Job{job, std::move(front), std::move(side), std::move(out)};
+            std::lock_guard lock(state_->mutex);
+            state_->job = Job{job, std::move(front), std::move(side), std::move(out)};
         }
-        wake_.notify_all();
+        state_->wake.notify_all();
     }
     std::optional<FitResult> takeResult() {
-        std::lock_guard lock(mutex_);
-        std::optional<FitResult> r = std::move(result_);
-        result_.reset();
+        std::lock_guard lock(state_->mutex);
+        std::optional<FitResult> r = std::move(state_->result);
+        state_->result.reset();
         return r;
     }
     std::optional<std::string> takeStage() {
-        std::lock_guard lock(mutex_);
-        std::optional<std::string> s = std::move(stage_);
-        stage_.reset();
+        std::lock_guard lock(state_->mutex);
+        std::optional<std::string> s = std::move(state_->stage);
+        state_->stage.reset();
         return s;
     }
+
+    static inline std::atomic<bool> threadLeftRunning{false};
 
 private:
     struct Job {
@@ -203,28 +235,53 @@ private:
         cv::Mat front, side;
         fs::path out;
     };
+    struct State {
+        std::shared_ptr<std::mutex> detectorMutex;
+        std::shared_ptr<const BaseHead> base;
+        std::mutex mutex;
+        std::condition_variable wake;
+        bool loading = true;
+        bool quit = false;
+        std::unique_ptr<FitPipeline> pipeline;
+        std::optional<std::string> loadError;
+        std::optional<Job> job;
+        std::optional<FitResult> result;
+        std::optional<std::string> stage;
+    };
 
-    void run() {
+    static void load(State& s, const FitSettings& settings) {
+        // (Not niced: nice is weighed against every process on the machine, and a model that loads minutes late keeps
+        // a visitor on the processing screen; the main loop never waits for it anyway.)
+        std::unique_ptr<FitPipeline> loaded;
+        std::optional<std::string> error;
         try {
-            auto pipeline = std::make_unique<FitPipeline>(settings_, *base_);
-            spdlog::info("landmark model loaded in {:.2f} s", pipeline->modelLoadSeconds());
-            std::lock_guard lock(mutex_);
-            pipeline_ = std::move(pipeline);
+            loaded = std::make_unique<FitPipeline>(settings, *s.base);
         } catch (const std::exception& e) {
-            spdlog::error("cannot load the landmark model: {}", e.what());
-            std::lock_guard lock(mutex_);
-            loadError_ = e.what();
+            error = e.what();
+        }
+        std::lock_guard lock(s.mutex);
+        s.loading = false;
+        if (s.quit) return;  // abandoned (or stopped) while loading: the model is dropped here, nothing logged
+        if (error) {
+            spdlog::error("cannot load the landmark model: {}", *error);
+            s.loadError = error;
             return;
         }
+        spdlog::info("landmark model loaded in {:.2f} s", loaded->modelLoadSeconds());
+        s.pipeline = std::move(loaded);
+        s.wake.notify_all();
+    }
+
+    static void fit(State& s) {
         std::unique_ptr<MeshRenderer> renderer;
         for (;;) {
             Job job;
             {
-                std::unique_lock lock(mutex_);
-                wake_.wait(lock, [&] { return quit_ || job_.has_value(); });
-                if (quit_) return;
-                job = std::move(*job_);
-                job_.reset();
+                std::unique_lock lock(s.mutex);
+                s.wake.wait(lock, [&] { return s.quit || (s.pipeline && s.job.has_value()); });
+                if (s.quit) return;
+                job = std::move(*s.job);
+                s.job.reset();
             }
             FitResult result;
             result.job = job.id;
@@ -233,17 +290,17 @@ private:
                 const FitInputs names{"front photo", "side photo", {}};
                 FitOutcome outcome;
                 {
-                    std::lock_guard detector(detectorMutex_);
-                    outcome = pipeline_->fit(job.front, job.side, cv::Mat(), names, [&](const std::string& stage) {
-                        std::lock_guard lock(mutex_);
-                        stage_ = stage;
+                    std::lock_guard detector(*s.detectorMutex);
+                    outcome = s.pipeline->fit(job.front, job.side, cv::Mat(), names, [&](const std::string& stage) {
+                        std::lock_guard lock(s.mutex);
+                        s.stage = stage;
                     });
                 }
                 {
-                    std::lock_guard lock(mutex_);
-                    stage_ = "export";
+                    std::lock_guard lock(s.mutex);
+                    s.stage = "export";
                 }
-                pipeline_->write(outcome, FitInputs{"front.jpg", "side.jpg", {}}, job.out, *renderer);
+                s.pipeline->write(outcome, FitInputs{"front.jpg", "side.jpg", {}}, job.out, *renderer);
                 result.ok = true;
                 result.folder = job.out;
                 result.mesh = outcome.fit.mesh;
@@ -253,21 +310,66 @@ private:
             } catch (const std::exception& e) {
                 result.error = BoothError(ErrorKind::Internal, "", e.what());
             }
-            std::lock_guard lock(mutex_);
-            result_ = std::move(result);
+            std::lock_guard lock(s.mutex);
+            s.result = std::move(result);
         }
     }
 
-    FitSettings settings_;
-    std::shared_ptr<const BaseHead> base_;
-    std::mutex& detectorMutex_;
-    mutable std::mutex mutex_;
+    std::shared_ptr<State> state_;
+    std::thread loader_, fitter_;
+};
+
+// The systemd watchdog (sd_notify WATCHDOG=1). Pinged from its own thread at half of WatchdogSec (WATCHDOG_USEC,
+// sd_watchdog_enabled(): the convention sd_notify(3) gives), so the pings keep their rate however long one frame
+// takes on a slow board -- but only while the main loop is alive: every loop iteration calls alive(), and when
+// none has for a whole WatchdogSec the pings stop (logged once) and systemd kills and restarts the hung booth.
+// Without a watchdog in the environment it pings once a second (a no-op without NOTIFY_SOCKET).
+class WatchdogPinger {
+public:
+    WatchdogPinger() {
+        std::uint64_t usec = 0;
+        if (sd_watchdog_enabled(0, &usec) > 0 && usec > 0) {
+            interval_ = std::chrono::microseconds(usec / 2);
+            stalledAfter_ = std::chrono::microseconds(usec);
+        }
+        alive();
+        spdlog::info("watchdog: a ping every {} ms while the main loop runs", std::chrono::duration_cast<std::chrono::milliseconds>(interval_).count());
+        thread_ = std::thread([this] { run(); });
+    }
+    ~WatchdogPinger() {
+        {
+            std::lock_guard lock(mutex_);
+            quit_ = true;
+        }
+        wake_.notify_all();
+        thread_.join();
+    }
+    void alive() { lastAlive_.store(std::chrono::steady_clock::now().time_since_epoch().count()); }
+
+private:
+    void run() {
+        bool withheld = false;
+        std::unique_lock lock(mutex_);
+        for (;;) {
+            if (wake_.wait_for(lock, interval_, [&] { return quit_; })) return;
+            const auto age = std::chrono::steady_clock::now() -
+                             std::chrono::steady_clock::time_point(std::chrono::steady_clock::duration(lastAlive_.load()));
+            if (age <= stalledAfter_) {
+                sd_notify(0, "WATCHDOG=1");
+                if (withheld) spdlog::warn("watchdog: the main loop runs again, pings resumed");
+                withheld = false;
+            } else if (!withheld) {
+                spdlog::error("watchdog: the main loop has not run for {:.1f} s, pings withheld", Seconds(age).count());
+                withheld = true;
+            }
+        }
+    }
+
+    std::chrono::steady_clock::duration interval_ = std::chrono::seconds(1);
+    std::chrono::steady_clock::duration stalledAfter_ = std::chrono::seconds(10);
+    std::atomic<std::chrono::steady_clock::rep> lastAlive_{0};
+    std::mutex mutex_;
     std::condition_variable wake_;
-    std::unique_ptr<FitPipeline> pipeline_;
-    std::optional<std::string> loadError_;
-    std::optional<Job> job_;
-    std::optional<FitResult> result_;
-    std::optional<std::string> stage_;
     bool quit_ = false;
     std::thread thread_;  // last: starts once everything above exists
 };
@@ -306,11 +408,12 @@ public:
         result_.reset();
         return r;
     }
-    // Waits for an analysis in flight to end (before a fit takes the detector).
-    void drain() {
-        std::unique_lock lock(mutex_);
+    // Drops a frame not yet analysed; true when no analysis is running (the fit may take the detector). Never
+    // waits: the main loop asks again next frame rather than stand still for a slow analysis.
+    bool release() {
+        std::lock_guard lock(mutex_);
         pending_.reset();
-        idle_.wait(lock, [&] { return !busy_; });
+        return !busy_;
     }
     double analysesPerSecond() const {
         std::lock_guard lock(mutex_);
@@ -324,6 +427,7 @@ private:
         FlowTime t;
     };
     void run() {
+        lowerThisThreadsPriority(5);  // the hint may lag a frame; the screen and the watchdog must not
         for (;;) {
             Pending job;
             const LandmarkDetector* detector = nullptr;
@@ -353,14 +457,13 @@ private:
             rate_ = seconds > 0.0 ? 1.0 / seconds : 0.0;
             result_ = result;
             busy_ = false;
-            idle_.notify_all();
         }
     }
 
     GuidanceSettings settings_;
     std::mutex& detectorMutex_;
     mutable std::mutex mutex_;
-    std::condition_variable wake_, idle_;
+    std::condition_variable wake_;
     const LandmarkDetector* detector_ = nullptr;
     std::unique_ptr<PreviewAnalyser> analyser_;      // used by the worker thread only
     const LandmarkDetector* analyserDetector_ = nullptr;
@@ -391,19 +494,23 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
-void writeScreenshot(const fs::path& dir, int index, ScreenId id, const cv::Mat& frame, KioskReport& report) {
+// replace: the screen's picture again, over the one written before under this index.
+void writeScreenshot(const fs::path& dir, int index, ScreenId id, const cv::Mat& frame, KioskReport& report,
+                     bool replace = false) {
     char name[64];
     std::snprintf(name, sizeof name, "%02d_%s.png", index, toString(id));
     const fs::path path = dir / name;
     try {
         writeFileAtomically(path, encodeImage(frame, ".png"));
-        report.screenshots.push_back(path);
+        if (!replace) report.screenshots.push_back(path);
     } catch (const BoothError& e) {
         spdlog::warn("screenshot not written: {}", e.what());
     }
 }
 
 }  // namespace
+
+bool kioskLeftAThreadRunning() { return FitWorker::threadLeftRunning.load(); }
 
 KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     const auto startup = std::chrono::steady_clock::now();
@@ -443,9 +550,13 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     if (!options.screenshots.empty()) fs::create_directories(options.screenshots);
 
     // --- Workers: the model loads in the background while the attract screen already runs.
-    std::mutex detectorMutex;
+    // OpenCV's worker pool is made by the first thread that needs it and its threads inherit that thread's priority:
+    // made here, by the main loop's thread, before the workers lower theirs.
+    cv::parallel_for_(cv::Range(0, 2 * std::max(1, cv::getNumThreads())), [](const cv::Range&) {});
+    // (Shared: the fitter's State holds it, and that State may outlive this function with the loading thread.)
+    auto detectorMutex = std::make_shared<std::mutex>();
     FitWorker fitter(config.fit.settings, configuredBaseHead(config.fit), detectorMutex);
-    PreviewWorker previews(config.guidance, detectorMutex);
+    PreviewWorker previews(config.guidance, *detectorMutex);
     bool detectorGiven = false;
     AvatarStage stage(config.animation, 480);
     {
@@ -466,8 +577,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     std::string cameraProblem;
     std::string sessionId;
     ScreenId lastScreen = flow.screen().id;
+    Hint lastHint = Hint::None;
     bool screenshotDue = !options.screenshots.empty();
     int screenshotIndex = 0;
+    int hintlessGuideShot = -1;  // the index of a guide's screenshot taken before its first hint was known
     std::vector<std::pair<Button, FlowTime>> releases;  // simulated presses to release
     auto lastRetention = std::chrono::steady_clock::now();
     // Benchmark figures.
@@ -477,7 +590,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     // (Plain time points with a flag: gcc 12 takes optional<time_point> for maybe-uninitialised here.)
     std::chrono::steady_clock::time_point sideTakenAt{}, lastGuideFrame{};
     bool sideTaken = false, inGuide = false;
-    auto lastWatchdog = std::chrono::steady_clock::time_point{};
+    std::optional<WatchdogPinger> watchdog;  // from READY on
     bool ready = false;
 
     const auto execute = [&](const FlowCommand& command, FlowTime now) {
@@ -631,8 +744,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
 
         // The fit: started once the model is there and the analysis has let go of the detector.
-        if (fitWanted && fitter.pipeline()) {
-            previews.drain();
+        if (fitWanted && fitter.pipeline() && previews.release()) {
             (void)previews.take();
             pendingFolder = store.pendingPath();
             fitter.submit(++fitJob, frontPhoto, sidePhoto, pendingFolder);
@@ -718,14 +830,26 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             }
         }
         if (screen.id != lastScreen) {
-            lastScreen = screen.id;
             screenshotDue = !options.screenshots.empty();
+            hintlessGuideShot = -1;
         }
-        // A screen's picture once it has what it shows: the preview on guides, the avatar on the reveal.
+        // A screen's picture once it has what it shows: the preview on guides, the avatar on the reveal. A guide
+        // whose first hint was not known yet (the first analysis is slow on a slow board) is taken again, under the
+        // same name, once it is.
+        const bool guide = screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide;
+        if (guide && (screen.id != lastScreen || screen.hint != lastHint))
+            spdlog::info("{}: hint {}", toString(screen.id), toString(screen.hint));
+        lastHint = screen.hint;
+        if (hintlessGuideShot >= 0 && screen.hint != Hint::None) {
+            writeScreenshot(options.screenshots, hintlessGuideShot, screen.id, drawn, report, true);
+            hintlessGuideShot = -1;
+        }
         const bool complete = (!previewScreen || (!inputs.preview.empty() && screen.sinceEntered >= Millis(700))) &&
                               (screen.id != ScreenId::Reveal || !inputs.avatar.empty()) &&
                               (screen.id != ScreenId::Thanks || !screen.code.empty());
+        lastScreen = screen.id;
         if (screenshotDue && complete) {
+            if (guide && screen.hint == Hint::None) hintlessGuideShot = screenshotIndex;
             writeScreenshot(options.screenshots, screenshotIndex++, screen.id, drawn, report);
             screenshotDue = false;
         }
@@ -734,14 +858,12 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             ready = true;
             report.startupToReadySeconds = Seconds(std::chrono::steady_clock::now() - startup).count();
             spdlog::info("ready in {:.2f} s{}", report.startupToReadySeconds, simCamera ? " (simulated booth)" : "");
+            watchdog.emplace();
         }
 
-        // Housekeeping: watchdog, retention.
+        // Housekeeping: the watchdog hears that the loop is alive; retention.
+        watchdog->alive();
         const auto wall = std::chrono::steady_clock::now();
-        if (wall - lastWatchdog >= kWatchdogEvery) {
-            sd_notify(0, "WATCHDOG=1");
-            lastWatchdog = wall;
-        }
         if (wall - lastRetention >= kRetentionEvery) {
             const RetentionReport r = store.applyRetention(std::chrono::system_clock::now());
             if (r.photosDeleted || r.sessionsDeleted)
@@ -754,6 +876,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         if (std::chrono::steady_clock::now() > nextFrame + 4 * kFramePeriod) nextFrame = std::chrono::steady_clock::now();
     }
     sd_notify(0, "STOPPING=1");
+    watchdog.reset();
     report.guideFramesPerSecond = guideSeconds > 0.0 ? guideFrames / guideSeconds : 0.0;
     report.analysesPerSecond = guideSeconds > 0.0 ? analyses / guideSeconds : 0.0;
     report.sideCaptureToRevealSeconds = median(captureToReveal);

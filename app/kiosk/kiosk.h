@@ -56,4 +56,10 @@ struct KioskReport {
 // configuration cannot be used at start-up (a camera lost later is waited for, not fatal).
 KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options);
 
+// True once runKiosk has returned (or thrown) while the landmark model was still loading: dlib's deserialisation
+// cannot be interrupted, so that thread was left running rather than joined (stopping must not wait minutes). The
+// process must then end with std::quick_exit (after flushing its output), not exit(): static destructors would run
+// under the still-running load.
+bool kioskLeftAThreadRunning();
+
 }  // namespace avatarbooth

@@ -1,17 +1,19 @@
 // The booth daemon end to end in the guest: `avatarbooth run` with the vivid camera, gpio-sim buttons and the
 // headless display goes from attract to the front guide on a press of the start button made with the sim's `pull`
-// attribute; vivid shows no face, so the guide never counts down, and the booth stays up (systemd watchdog pings
-// keep coming, received on our own NOTIFY_SOCKET) until it is stopped with SIGTERM, exiting 0.
+// attribute; vivid shows no face, so the guide says so (its screenshot's hint text is the "no face" one, from the
+// face cascade alone: the landmark model is still loading, minutes under emulation) and never counts down, and the
+// booth stays up -- systemd watchdog pings (WATCHDOG_USEC=4 s: one every 2 s) keep coming on our own NOTIFY_SOCKET --
+// until SIGTERM, which ends it promptly with exit code 0 although the model load has not finished.
 #include "kernel_guest.h"
+#include "kiosk_daemon_checks.h"
 
 #include "drivers/camera/v4l2_camera.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include <signal.h>
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -29,43 +31,11 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using kernel_test::readFile;
 using kernel_test::writeFile;
+using test::NotifySocket;
 
 const fs::path kConfig = "/sys/kernel/config/gpio-sim/avatarbooth-daemon";
 constexpr const char* kLabel = "avatarbooth-daemon";
-constexpr const char* kNotifyName = "avatarbooth-kernel-test-notify";  // abstract socket name
-
-// Counts the sd_notify datagrams ("READY=1", "WATCHDOG=1") the daemon sends to an abstract unix socket.
-class NotifySocket {
-public:
-    NotifySocket() {
-        fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
-        sockaddr_un a{};
-        a.sun_family = AF_UNIX;
-        std::memcpy(a.sun_path + 1, kNotifyName, std::strlen(kNotifyName));  // sun_path[0] = 0: abstract
-        const auto len = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + 1 + std::strlen(kNotifyName));
-        ok_ = fd_ >= 0 && bind(fd_, reinterpret_cast<sockaddr*>(&a), len) == 0;
-    }
-    ~NotifySocket() {
-        if (fd_ >= 0) close(fd_);
-    }
-    bool ok() const { return ok_; }
-    // Reads what has arrived; counts READY and WATCHDOG messages.
-    void drain() {
-        char buf[512];
-        for (;;) {
-            const ssize_t n = recv(fd_, buf, sizeof buf - 1, 0);
-            if (n <= 0) return;
-            const std::string m(buf, static_cast<std::size_t>(n));
-            if (m.find("READY=1") != std::string::npos) ++ready;
-            if (m.find("WATCHDOG=1") != std::string::npos) ++watchdog;
-        }
-    }
-    int ready = 0, watchdog = 0;
-
-private:
-    int fd_ = -1;
-    bool ok_ = false;
-};
+constexpr int kWatchdogUsec = 4000000;
 
 std::string vividNode() {
     for (const auto& node : listV4l2Nodes()) {
@@ -75,10 +45,16 @@ std::string vividNode() {
     return "";
 }
 
-// DISABLED: measured in the guest (TCG) on 2026-11-22 it reaches attract ("ready in 88 s"), the GPIO press gives
-// the front guide and it does not count down, but no watchdog ping came in 4 s while in the guide, and SIGTERM
-// took over 10 s (the landmark model was still loading: 122 s). Run it with
-// --gtest_also_run_disabled_tests (tests/kernel/README.md) once start-up and the main loop keep up in the guest.
+double secondsSince(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// DISABLED: measured in the guest (TCG) on 2026-11-22 with the host's two cores shared by other builds (load 12-23):
+// READY after 146 s, the model loaded in 152 s, the press gives the front guide and the "no face" hint (screenshot
+// and log checks pass), no countdown -- but the main loop itself ran at 0.1 frames/s (4-10 s per iteration), so the
+// watchdog pinger rightly withheld pings (WATCHDOG_USEC=4 s) and SIGTERM took 18 s (one iteration, then the
+// teardown). The host twin (tests/e2e/kiosk_daemon_test.cpp) checks the same behaviour at native speed. Run it with
+// --gtest_also_run_disabled_tests (tests/kernel/README.md) on an unloaded machine.
 TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWithoutAFace) {
     AVATARBOOTH_REQUIRE_KERNEL_GUEST();
     if (!fs::exists(test::binary())) GTEST_SKIP() << test::binary() << " is not built";
@@ -110,18 +86,20 @@ TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWit
                           << "[[buttons.lamp]]\nname = \"start\"\noffset = 4\n"
                           << "[[buttons.lamp]]\nname = \"retake\"\noffset = 5\n"
                           << "[[buttons.lamp]]\nname = \"flash\"\noffset = 6\n"
-                          << "[display]\nbackend = \"headless\"\n"
+                          // A small screen: drawing and the screenshots' PNGs cost 4x less under emulation.
+                          << "[display]\nbackend = \"headless\"\nwidth = 640\nheight = 360\n"
                           // The source tree's strings: the build tree is not installed in the guest.
                           << "[screen]\nstrings_file = \"" << AVATARBOOTH_TEST_SOURCE_DIR << "/app/assets/strings.toml\"\n"
                           << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
 
-    NotifySocket notify;
+    NotifySocket notify("guest");
     ASSERT_TRUE(notify.ok()) << std::strerror(errno);
     const fs::path log = dir / "log.txt", screens = dir / "screens";
     const pid_t pid = fork();
     ASSERT_GE(pid, 0);
     if (pid == 0) {
-        setenv("NOTIFY_SOCKET", (std::string("@") + kNotifyName).c_str(), 1);
+        setenv("NOTIFY_SOCKET", notify.env().c_str(), 1);
+        setenv("WATCHDOG_USEC", std::to_string(kWatchdogUsec).c_str(), 1);
         setenv("EGL_PLATFORM", "surfaceless", 1);
         const std::string bin = test::binary().string();
         execl("/bin/sh", "sh", "-c",
@@ -134,44 +112,69 @@ TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWit
     auto exited = [&](int* status) { return waitpid(pid, status, WNOHANG) == pid; };
     int status = 0;
     bool gone = false;
-    // Up and showing the attract screen (start-up loads the landmark model: slow in the emulated guest).
-    const auto deadline = std::chrono::steady_clock::now() + 240s;
-    while (!fs::exists(screens / "00_attract.png") && std::chrono::steady_clock::now() < deadline &&
-           !(gone = exited(&status)))
-        std::this_thread::sleep_for(200ms);
-    notify.drain();
-    if (!gone && fs::exists(screens / "00_attract.png")) {
-        EXPECT_EQ(notify.ready, 1);
+    // Polls for `done`, reading the notify socket as it goes (a ping's time is when it is read).
+    const auto waitFor = [&](const auto& done, std::chrono::steady_clock::duration limit) {
+        const auto end = std::chrono::steady_clock::now() + limit;
+        while (!done() && std::chrono::steady_clock::now() < end && !(gone = gone || exited(&status))) {
+            notify.drain();
+            std::this_thread::sleep_for(50ms);
+        }
+        notify.drain();
+        return done();
+    };
+    // Up and showing the attract screen (READY=1 does not wait for the landmark model; the first frame waits for
+    // Mesa's llvmpipe to start and render the turning head: 88 s measured under emulation on a busy machine).
+    const auto started = std::chrono::steady_clock::now();
+    const bool attract = waitFor([&] { return fs::exists(screens / "00_attract.png"); }, 300s);
+    const double startSeconds = secondsSince(started);
+    double guideSeconds = 0.0, stopSeconds = 0.0;
+    bool guide = false;
+    if (attract) {
+        EXPECT_EQ(notify.ready.size(), 1u);
         // The visitor presses start (the line pulled low), then lets go.
         EXPECT_TRUE(writeFile(sim / "sim_gpio0/pull", "pull-down"));
         std::this_thread::sleep_for(300ms);
         EXPECT_TRUE(writeFile(sim / "sim_gpio0/pull", "pull-up"));
-        const auto guideBy = std::chrono::steady_clock::now() + 60s;
-        while (!fs::exists(screens / "01_front_guide.png") && std::chrono::steady_clock::now() < guideBy &&
-               !(gone = exited(&status)))
-            std::this_thread::sleep_for(200ms);
-        // It stays in the guide: no face, so no countdown, and the daemon keeps pinging the watchdog.
-        const int pingsBefore = (notify.drain(), notify.watchdog);
-        for (int i = 0; i < 8 && !gone; ++i) {
-            std::this_thread::sleep_for(500ms);
-            gone = exited(&status);
-        }
-        notify.drain();
-        EXPECT_GE(notify.watchdog - pingsBefore, 2) << "watchdog pings stopped";
+        // The guide's screenshot is written once its first hint (the first analysis of a vivid frame) is known.
+        const auto pressed = std::chrono::steady_clock::now();
+        guide = waitFor([&] { return fs::exists(screens / "01_front_guide.png"); }, 90s);
+        guideSeconds = secondsSince(pressed);
+        // The first analysis's hint (the screenshot is taken again with it when it came later than the picture).
+        waitFor([&] { return readFile(log).find("front_guide: hint no_face") != std::string::npos; }, 60s);
+        // It stays in the guide: no face, so no countdown, and the watchdog pings keep coming, one every 2 s.
+        const auto from = std::chrono::steady_clock::now();
+        waitFor([] { return false; }, 8s);
+        const auto to = std::chrono::steady_clock::now();
+        EXPECT_GE(notify.pingsSince(from), 3) << "watchdog pings stopped";
+        EXPECT_LT(notify.longestGapSeconds(from, to), kWatchdogUsec / 1e6) << "a watchdog ping came too late";
     }
     if (!gone) {
+        const auto term = std::chrono::steady_clock::now();
         kill(pid, SIGTERM);
-        for (int i = 0; i < 100 && !(gone = exited(&status)); ++i) std::this_thread::sleep_for(100ms);
+        waitFor([&] { return gone; }, 20s);
+        stopSeconds = secondsSince(term);
         if (!gone) {
             kill(pid, SIGKILL);
             waitpid(pid, &status, 0);
         }
     }
+    std::printf("[daemon] attract after %.1f s, front guide %.1f s after the press, stopped %.1f s after SIGTERM\n",
+                startSeconds, guideSeconds, stopSeconds);
     const std::string output = readFile(log);
+    ASSERT_TRUE(attract) << "no attract screen\n" << output;
     ASSERT_TRUE(gone) << "did not stop on SIGTERM\n" << output;
+    // Under emulation (5-20x slower) the 2 s the host test asks for becomes this.
+    EXPECT_LT(stopSeconds, 10.0) << output;
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "status " << status << "\n" << output;
     EXPECT_TRUE(fs::exists(screens / "00_attract.png")) << output;
-    EXPECT_TRUE(fs::exists(screens / "01_front_guide.png")) << output;
+    ASSERT_TRUE(guide) << "no front guide screenshot\n" << output;
+    const cv::Mat shot = cv::imread((screens / "01_front_guide.png").string());
+    ASSERT_FALSE(shot.empty());
+    const fs::path strings = fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "app/assets/strings.toml";
+    EXPECT_GT(test::guideHintMatch(shot, ScreenId::FrontGuide, Hint::NoFace, strings), 0.8) << "no \"no face\" hint";
+    EXPECT_LT(test::guideHintMatch(shot, ScreenId::FrontGuide, Hint::None, strings), 0.5);
+    EXPECT_NE(output.find("front_guide: hint no_face"), std::string::npos) << output;
+    EXPECT_EQ(output.find("pings withheld"), std::string::npos) << output;
     EXPECT_FALSE(fs::exists(screens / "02_countdown.png")) << "counted down without a face\n" << output;
     EXPECT_NE(output.find("a visitor started a session"), std::string::npos) << output;
     EXPECT_NE(output.find(node), std::string::npos) << "the log does not name the vivid camera\n" << output;

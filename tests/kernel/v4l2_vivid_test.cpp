@@ -226,5 +226,45 @@ TEST_F(Vivid, DisconnectWhileStreamingIsRecoveredByReopening) {
     EXPECT_EQ(join(barsAlong(frame->image, frame->image.rows * 3 / 4)), join(kColourBars));
 }
 
+// Unplugging by unloading the module: the kernel refuses to unload vivid while any file handle on its node is open
+// (opening a V4L2 node takes a reference on the driver's module), streaming or not -- `rmmod` says "in use". Once
+// vivid's disconnect control has made us close the node (our ReopeningCamera closes it on the error and waits
+// before reopening), rmmod succeeds: the node is gone, the camera keeps trying, and when the module is loaded again
+// the camera comes back by itself. (Runs last: it reloads vivid with the suite's arguments.)
+TEST_F(Vivid, UnloadedWhileLostAndLoadedAgainIsRecovered) {
+    settings_.reopenFirstDelaySeconds = 2;  // the window in which nothing holds the node and rmmod may run
+    settings_.reopenMaxDelaySeconds = 2;
+    auto camera = openReopeningCamera(settings_);
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(camera->nextFrame(10s).has_value());
+    EXPECT_NE(kernel_test::run("rmmod vivid 2>/dev/null"), 0) << "vivid unloaded while we stream from it";
+    EXPECT_GT(std::stoi(kernel_test::readFile("/sys/module/vivid/refcnt")), 0);
+
+    ASSERT_EQ(kernel_test::run("v4l2-ctl -d " + node_ + " -c disconnect=1"), 0);
+    bool lost = false;
+    for (int i = 0; i < 50 && !lost; ++i) {
+        camera->nextFrame(100ms);
+        lost = !camera->status().ok;
+    }
+    ASSERT_TRUE(lost) << "the camera never noticed the disconnect";
+    bool unloaded = false;
+    for (int i = 0; i < 40 && !unloaded; ++i) {
+        unloaded = kernel_test::run("rmmod vivid 2>/dev/null") == 0;
+        if (!unloaded) std::this_thread::sleep_for(50ms);
+    }
+    ASSERT_TRUE(unloaded) << "rmmod vivid still refused after our camera closed the node";
+    EXPECT_TRUE(vividNode().empty());
+    for (int i = 0; i < 10; ++i) EXPECT_FALSE(camera->nextFrame(200ms).has_value()) << "a frame without vivid";
+    EXPECT_FALSE(camera->status().ok);
+
+    ASSERT_EQ(kernel_test::modprobe("vivid n_devs=1 node_types=0x1"), 0);
+    std::optional<CameraFrame> frame;
+    for (int i = 0; i < 60 && !frame; ++i) frame = camera->nextFrame(500ms);
+    ASSERT_TRUE(frame.has_value()) << "no frame after vivid came back: " << camera->status().message;
+    EXPECT_TRUE(camera->status().ok) << camera->status().message;
+    EXPECT_GE(camera->status().recoveries, 1);
+    EXPECT_EQ(frame->image.cols, 640);
+    EXPECT_EQ(join(barsAlong(frame->image, frame->image.rows * 3 / 4)), join(kColourBars));
+}
+
 }  // namespace
 }  // namespace avatarbooth
