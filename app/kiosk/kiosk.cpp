@@ -431,7 +431,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     screenSettings.size = display.size();
     ScreenRenderer screens(screenSettings);
 
-    auto simControls = std::make_shared<SimCameraControls>();
+    auto simControls = options.simControls ? options.simControls : std::make_shared<SimCameraControls>();
     std::unique_ptr<ReopeningCamera> camera = openReopeningCamera(config.camera, CameraEnvironment{simControls, nullptr});
     note("camera: " + camera->describe().summary());
     const bool simCamera = camera->describe().backend == "sim";
@@ -532,6 +532,14 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                     } catch (const BoothError& e) {
                         spdlog::error("session not kept: {}", e.what());
                         events.push_back(SessionSaveFailed{e.what(), now});
+                        // Nothing of a session that could not be kept stays behind (the flow sends no discard
+                        // after a keep, and the next fit would reuse pendingFolder).
+                        try {
+                            if (!pendingFolder.empty()) store.discard(pendingFolder);
+                        } catch (const BoothError& d) {
+                            spdlog::error("discarding the session that was not kept: {}", d.what());
+                        }
+                        pendingFolder.clear();
                     }
                 } else if constexpr (std::is_same_v<T, DiscardSession>) {
                     if (!pendingFolder.empty()) {
