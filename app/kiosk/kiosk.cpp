@@ -250,7 +250,9 @@ private:
                     std::lock_guard lock(mutex_);
                     stage_ = "export";
                 }
-                pipeline_->write(outcome, FitInputs{"front.jpg", "side.jpg", {}}, job.out, *renderer);
+                // No input files: the photos are in memory and are written as JPEGs (file names here would be
+                // read from the working directory).
+                pipeline_->write(outcome, FitInputs{}, job.out, *renderer);
                 result.ok = true;
                 result.folder = job.out;
                 result.mesh = outcome.fit.mesh;
@@ -649,6 +651,14 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         if (fitWanted && fitter.pipeline()) {
             previews.drain();
             (void)previews.take();
+            // A retake fits again: the earlier fit's folder (the visitor's photos) goes first.
+            if (!pendingFolder.empty()) {
+                try {
+                    store.discard(pendingFolder);
+                } catch (const BoothError& e) {
+                    spdlog::error("discarding the earlier fit: {}", e.what());
+                }
+            }
             pendingFolder = store.pendingPath();
             fitter.submit(++fitJob, frontPhoto, sidePhoto, pendingFolder);
             spdlog::info("fitting into {}", pendingFolder.string());

@@ -28,6 +28,8 @@ BoothConfig fastSimBooth(const fs::path& visitorFolder, const fs::path& sessions
     c.display.width = 640;
     c.display.height = 360;
     c.sessions.directory = sessions;
+    // The source tree's strings (the test executables do not sit where the installed booth looks).
+    c.screen.stringsFile = fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "app" / "assets" / "strings.toml";
     BoothSettings& f = c.flow;
     f.countdown = Millis(300);
     f.steadyOk = Millis(200);

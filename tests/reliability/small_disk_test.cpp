@@ -38,6 +38,7 @@ TEST(SmallDisk, FullFilesystemWhileWritingThenSpaceFreed) {
     std::ofstream(config) << "[camera]\nbackend = \"sim\"\nsim_folder = \"" << visitor.string() << "\"\n"
                           << "[buttons]\nbackend = \"sim\"\n"
                           << "[display]\nbackend = \"headless\"\nwidth = 640\nheight = 360\n"
+                          << "[screen]\nstrings_file = \"" << AVATARBOOTH_TEST_SOURCE_DIR << "/app/assets/strings.toml\"\n"
                           << "[flow]\ncountdown_s = 1.0\nsteady_s = 0.0\nthanks_time_s = 1.0\nthanks_min_time_s = 0.0\n"
                           << "press_guard_s = 0.1\n"
                           << "[sessions]\ndirectory = \"" << (mnt / "sessions").string() << "\"\n";

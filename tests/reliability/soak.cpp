@@ -139,6 +139,7 @@ int main(int argc, char** argv) {
         minThreads = std::min(minThreads, s[i].threads);
         maxThreads = std::max(maxThreads, s[i].threads);
     }
+    if (s.size() <= static_cast<std::size_t>(warmup)) minFds = maxFds = minThreads = maxThreads = 0;
     const double drift = s.empty() ? 0.0 : s.back().rssMegabytes - warm.rssMegabytes;
     const RandomVisitorTally& t = visitor.tally();
 
