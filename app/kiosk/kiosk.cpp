@@ -625,6 +625,16 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             }
             cameraProblem = problem;
         }
+        if (!previewFor && !cameraProblem.empty()) {
+            // A lost camera is reopened by ReopeningCamera's calls; with no preview running (the camera-lost and
+            // attract screens stop it) nothing would call it, and the booth would never see the camera come back.
+            try {
+                (void)camera->nextFrame(std::chrono::milliseconds(0));
+                if (camera->status().ok) camera->stop();
+            } catch (const BoothError& e) {
+                spdlog::debug("camera retry: {}", e.what());
+            }
+        }
         if (previewFor) {
             try {
                 while (auto frame = camera->nextFrame(std::chrono::milliseconds(lastPreview.empty() ? 30 : 0)))
