@@ -141,7 +141,11 @@ TEST(DaemonKill, KilledWhileWritingLeavesOnlyCompleteSessionsAndRestartsFast) {
             else due = count(readFile(log), "fitting into") > fitsSeen;
             if (!due) std::this_thread::sleep_for(std::chrono::milliseconds(duringWrite ? 1 : 20));
         }
-        ASSERT_TRUE(due) << "no fit started: " << readFile(log);
+        if (!due) {  // never leave the daemon running behind a failed test
+            ::kill(d.pid, SIGKILL);
+            ::waitpid(d.pid, nullptr, 0);
+        }
+        ASSERT_TRUE(due) << "no fit seen in 60 s: " << readFile(log);
         fitsSeen = count(readFile(log), "fitting into");
         const int delayMs = std::uniform_int_distribution<int>(0, duringWrite ? 120 : 2500)(rng);
         std::this_thread::sleep_for(std::chrono::milliseconds(delayMs));
@@ -160,7 +164,11 @@ TEST(DaemonKill, KilledWhileWritingLeavesOnlyCompleteSessionsAndRestartsFast) {
             if (!kept.count(code)) kept[code] = fingerprint(sessions / code);
 
         d = spawnDaemon(config, log, notify);
-        ASSERT_TRUE(notify.waitReady(std::chrono::seconds(30))) << readFile(log);
+        if (!notify.waitReady(std::chrono::seconds(30))) {
+            ::kill(d.pid, SIGKILL);
+            ::waitpid(d.pid, nullptr, 0);
+            FAIL() << "no READY=1 within 30 s of the restart: " << readFile(log);
+        }
         readySeconds.push_back(Seconds(Clock::now() - d.started).count());
         EXPECT_EQ(checkSessions(sessions).leftovers, 0) << "the restarted booth did not clear the killed one's leftovers";
     }
