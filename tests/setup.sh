@@ -19,6 +19,8 @@ packages=(
   nodejs npm
   # the batch report test opens report.html in headless Chromium (driven by puppeteer-core from npm)
   chromium
+  # the reliability suite's fuzz targets (tests/fuzz/): clang with its libFuzzer and sanitizer runtimes
+  clang-14 libclang-rt-14-dev
   # the `kernel` tests (tests/kernel/): qemu boots Debian's kernel; busybox/cpio/kmod make its initramfs and
   # module tree (modules built with gcc-12/make); v4l-utils, udev, libcamera-ipa/-tools are used inside the guest
   qemu-system-x86 busybox-static cpio kmod xz-utils make gcc-12 libc6-dev v4l-utils udev libcamera-ipa libcamera-tools

@@ -8,6 +8,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <random>
@@ -37,16 +39,47 @@ void fsyncDirectory(const fs::path& dir) {
     }
 }
 
+// The injected failure: writes left before it strikes (-1: none injected), the errno it fails with, and a count.
+std::atomic<int> gWritesBeforeFailure{-1};
+std::atomic<int> gInjectedError{0};
+std::atomic<int> gInjectedFailures{0};
+
+// Whether this write is to fail by injection (consumes one allowed write otherwise).
+bool injectedFailureDue() {
+    int left = gWritesBeforeFailure.load();
+    while (left > 0 && !gWritesBeforeFailure.compare_exchange_weak(left, left - 1)) {
+    }
+    return left == 0;
+}
+
 }  // namespace
+
+void injectWriteFailure(int afterWrites, int error) {
+    gInjectedError = error;
+    gInjectedFailures = 0;
+    gWritesBeforeFailure = std::max(0, afterWrites);
+}
+
+void clearInjectedWriteFailure() { gWritesBeforeFailure = -1; }
+
+int injectedWriteFailures() { return gInjectedFailures.load(); }
 
 void writeFileAtomically(const fs::path& path, std::string_view bytes) {
     const fs::path tmp = path.string() + ".tmp-" + randomSuffix();
     // 0600: outputs hold photos of visitors, personal data readable only by the booth's user.
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
     if (fd < 0) failOutput(path, "cannot create", errno);
+    const bool injected = injectedFailureDue();
     std::size_t done = 0;
-    while (done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    while (done < bytes.size() || injected) {
+        // An injected failure strikes after half the bytes, as a disk filling up in the middle of a file does.
+        const std::size_t chunk = injected ? (bytes.size() - done) / 2 : bytes.size() - done;
+        ssize_t n = ::write(fd, bytes.data() + done, chunk);
+        if (injected && n >= 0) {
+            ++gInjectedFailures;
+            n = -1;
+            errno = gInjectedError.load();
+        }
         if (n < 0) {
             if (errno == EINTR) continue;
             const int err = errno;

@@ -11,6 +11,14 @@ namespace avatarbooth {
 // Writes bytes to path through path.tmp-XXXX + fsync + rename. Throws BoothError(Output) naming the file.
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 
+// Fault injection for the reliability tests (tests/reliability/): after `afterWrites` more successful
+// writeFileAtomically() calls, every later call fails as write(2) failing with `error` would (ENOSPC: the disk is
+// full), leaving no file behind, until clearInjectedWriteFailure(). Process-wide; off unless a test turns it on.
+void injectWriteFailure(int afterWrites, int error);
+void clearInjectedWriteFailure();
+// Writes refused by the injected failure since it was last injected.
+int injectedWriteFailures();
+
 // An output folder under construction. Files go into staging(); commit() moves the folder to its final name in
 // one step (replacing an earlier result of ours there). If commit() is never called, the staging folder is
 // removed and the final name is left untouched.

@@ -300,7 +300,9 @@ private:
                     std::lock_guard lock(s.mutex);
                     s.stage = "export";
                 }
-                s.pipeline->write(outcome, FitInputs{"front.jpg", "side.jpg", {}}, job.out, *renderer);
+                // No input files: the photos are in memory and are written as JPEGs (file names here would be
+                // read from the working directory).
+                s.pipeline->write(outcome, FitInputs{}, job.out, *renderer);
                 result.ok = true;
                 result.folder = job.out;
                 result.mesh = outcome.fit.mesh;
@@ -531,7 +533,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     screenSettings.size = display.size();
     ScreenRenderer screens(screenSettings);
 
-    auto simControls = std::make_shared<SimCameraControls>();
+    auto simControls = options.simControls ? options.simControls : std::make_shared<SimCameraControls>();
     std::unique_ptr<ReopeningCamera> camera = openReopeningCamera(config.camera, CameraEnvironment{simControls, nullptr});
     note("camera: " + camera->describe().summary());
     const bool simCamera = camera->describe().backend == "sim";
@@ -638,6 +640,14 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                     } catch (const BoothError& e) {
                         spdlog::error("session not kept: {}", e.what());
                         events.push_back(SessionSaveFailed{e.what(), now});
+                        // Nothing of a session that could not be kept stays behind (the flow sends no discard
+                        // after a keep, and the next fit would reuse pendingFolder).
+                        try {
+                            if (!pendingFolder.empty()) store.discard(pendingFolder);
+                        } catch (const BoothError& d) {
+                            spdlog::error("discarding the session that was not kept: {}", d.what());
+                        }
+                        pendingFolder.clear();
                     }
                 } else if constexpr (std::is_same_v<T, DiscardSession>) {
                     if (!pendingFolder.empty()) {
@@ -721,6 +731,16 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             }
             cameraProblem = problem;
         }
+        if (!previewFor && !cameraProblem.empty()) {
+            // A lost camera is reopened by ReopeningCamera's calls; with no preview running (the camera-lost and
+            // attract screens stop it) nothing would call it, and the booth would never see the camera come back.
+            try {
+                (void)camera->nextFrame(std::chrono::milliseconds(0));
+                if (camera->status().ok) camera->stop();
+            } catch (const BoothError& e) {
+                spdlog::debug("camera retry: {}", e.what());
+            }
+        }
         if (previewFor) {
             try {
                 while (auto frame = camera->nextFrame(std::chrono::milliseconds(lastPreview.empty() ? 30 : 0)))
@@ -746,6 +766,14 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         // The fit: started once the model is there and the analysis has let go of the detector.
         if (fitWanted && fitter.pipeline() && previews.release()) {
             (void)previews.take();
+            // A retake fits again: the earlier fit's folder (the visitor's photos) goes first.
+            if (!pendingFolder.empty()) {
+                try {
+                    store.discard(pendingFolder);
+                } catch (const BoothError& e) {
+                    spdlog::error("discarding the earlier fit: {}", e.what());
+                }
+            }
             pendingFolder = store.pendingPath();
             fitter.submit(++fitJob, frontPhoto, sidePhoto, pendingFolder);
             spdlog::info("fitting into {}", pendingFolder.string());

@@ -12,6 +12,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +36,9 @@ struct KioskOptions {
     std::filesystem::path screenshots;        // write a PNG of every screen shown into this folder (empty: none)
     VisitorScript* visitor = nullptr;         // a simulated visitor drives the sim camera's scene and presses
     const std::atomic<bool>* stop = nullptr;  // set (by a signal handler) to stop cleanly
+    // The simulated camera's world (scene, faults); made by the kiosk when null. Reliability tests pass their own
+    // to unplug the camera or corrupt frames while the booth runs.
+    std::shared_ptr<SimCameraControls> simControls;
 };
 
 struct KioskReport {

@@ -62,6 +62,7 @@ auto stage(FitOutcome& out, const StageListener& listener, const char* name, con
 
 std::string readBytes(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
+    if (!in) throw BoothError(ErrorKind::BadInput, path.string(), "cannot be read");
     return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 

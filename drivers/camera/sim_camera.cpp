@@ -1,6 +1,8 @@
 // The simulated camera: folder images in, paced noisy preview frames and exact stills out.
 #include "drivers/camera/sim_camera.h"
 
+#include "common/image_header.h"
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -17,6 +19,9 @@ namespace fs = std::filesystem;
 namespace {
 
 const cv::Scalar kNeutralBackdrop(160, 160, 160);
+// The largest recorded photo replayed (as common/image_io's PhotoLimits: a 24-megapixel still is the largest a
+// booth camera makes).
+constexpr std::int64_t kMaxPixels = 40'000'000;
 
 std::string lower(std::string s) {
     for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -49,6 +54,8 @@ bool endsWith(const std::vector<unsigned char>& b, std::initializer_list<unsigne
 
 // Reads a JPEG or PNG, refusing truncated files (OpenCV would decode them with a grey lower part).
 cv::Mat readImage(const fs::path& path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) badFile(path, "is not a regular file (a folder with an image's name?)");
     std::ifstream in(path, std::ios::binary);
     if (!in) badFile(path, "cannot be read");
     std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -60,6 +67,12 @@ cv::Mat readImage(const fs::path& path) {
     while (jpeg && !end.empty() && end.back() == 0) end.pop_back();
     if (jpeg ? !endsWith(end, {0xFF, 0xD9}) : !endsWith(bytes, {'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82}))
         badFile(path, "is truncated (the image's end marker is missing)");
+    // A small file may declare a huge image: refuse it before the decoder allocates for it.
+    const ImageHeader header = readImageHeader(bytes.data(), bytes.size());
+    if (header.width <= 0 || header.height <= 0)
+        badFile(path, "declares no image size (damaged header)");
+    if (header.width > kMaxPixels || header.height > kMaxPixels || header.width * header.height > kMaxPixels)
+        badFile(path, "is too large (" + std::to_string(header.width) + "x" + std::to_string(header.height) + ")");
     cv::Mat image = cv::imdecode(bytes, cv::IMREAD_COLOR);
     if (image.empty()) badFile(path, "cannot be decoded as an image (corrupt data)");
     return image;

@@ -1,0 +1,32 @@
+// Reading /proc/self/status and /proc/self/fd.
+#include "sim/process_figures.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace avatarbooth {
+
+ProcessFigures readProcessFigures() {
+    ProcessFigures f;
+    std::ifstream status("/proc/self/status");
+    std::string line;
+    while (std::getline(status, line)) {
+        std::istringstream fields(line);
+        std::string key;
+        double value = 0.0;
+        fields >> key >> value;
+        if (key == "VmRSS:") f.rssMegabytes = value / 1024.0;
+        else if (key == "VmHWM:") f.peakRssMegabytes = value / 1024.0;
+        else if (key == "Threads:") f.threads = static_cast<int>(value);
+    }
+    std::error_code ec;
+    for (auto it = std::filesystem::directory_iterator("/proc/self/fd", ec);
+         !ec && it != std::filesystem::directory_iterator(); it.increment(ec))
+        ++f.openFiles;
+    if (f.openFiles > 0) --f.openFiles;  // the iterator's own descriptor
+    return f;
+}
+
+}  // namespace avatarbooth

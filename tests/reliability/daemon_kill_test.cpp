@@ -1,0 +1,201 @@
+// The daemon (`avatarbooth run` as a child process, the simulated booth) is killed with SIGKILL at random points
+// while it fits and writes sessions, and started again: every session folder present is complete (its glb valid),
+// the sessions kept before are untouched, the next start removes what the killed one left, and the restarted booth
+// tells systemd READY=1 (attract screen up) within 2 s.
+#include "reliability_support.h"
+
+#include "test_paths.h"
+
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <random>
+#include <thread>
+
+namespace fs = std::filesystem;
+using namespace avatarbooth;
+using namespace avatarbooth::reliability;
+using Clock = std::chrono::steady_clock;
+using Seconds = std::chrono::duration<double>;
+
+namespace {
+
+std::string readFile(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+}
+
+// The systemd notification socket the daemon's sd_notify() writes to (NOTIFY_SOCKET).
+class NotifySocket {
+public:
+    explicit NotifySocket(const fs::path& path) : path_(path) {
+        fs::remove(path_);
+        fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+        sockaddr_un addr{};
+        addr.sun_family = AF_UNIX;
+        std::snprintf(addr.sun_path, sizeof addr.sun_path, "%s", path_.c_str());
+        if (::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) ADD_FAILURE() << "bind " << path_;
+    }
+    ~NotifySocket() { ::close(fd_); }
+    const fs::path& path() const { return path_; }
+    // Waits for a datagram holding READY=1; false on timeout.
+    bool waitReady(std::chrono::milliseconds timeout) {
+        const auto end = Clock::now() + timeout;
+        while (Clock::now() < end) {
+            pollfd p{fd_, POLLIN, 0};
+            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - Clock::now()).count();
+            if (::poll(&p, 1, static_cast<int>(std::max<long>(1, left))) <= 0) continue;
+            char buf[4096];
+            const ssize_t n = ::recv(fd_, buf, sizeof buf - 1, 0);
+            if (n > 0 && std::string(buf, static_cast<std::size_t>(n)).find("READY=1") != std::string::npos) return true;
+        }
+        return false;
+    }
+
+private:
+    fs::path path_;
+    int fd_ = -1;
+};
+
+struct Daemon {
+    pid_t pid = -1;
+    Clock::time_point started;
+};
+
+Daemon spawnDaemon(const fs::path& config, const fs::path& log, const NotifySocket& notify) {
+    Daemon d;
+    d.started = Clock::now();
+    d.pid = ::fork();
+    if (d.pid == 0) {
+        const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0600);
+        ::dup2(fd, 1);
+        ::dup2(fd, 2);
+        ::setenv("NOTIFY_SOCKET", notify.path().c_str(), 1);
+        ::setenv("EGL_PLATFORM", "surfaceless", 1);
+        const std::string bin = test::binary().string();
+        const std::string cfg = config.string();
+        ::execl(bin.c_str(), bin.c_str(), "run", "--config", cfg.c_str(), "--sessions", "100", static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    return d;
+}
+
+// A folder being staged under .pending/ (the fit is writing its files).
+bool writingNow(const fs::path& sessions) {
+    std::error_code ec;
+    for (auto it = fs::directory_iterator(sessions / ".pending", ec); !ec && it != fs::directory_iterator(); it.increment(ec))
+        if (it->path().filename().string().find(".partial-") != std::string::npos) return true;
+    return false;
+}
+
+}  // namespace
+
+TEST(DaemonKill, KilledWhileWritingLeavesOnlyCompleteSessionsAndRestartsFast) {
+    const fs::path dir = test::scratchDir("reliability_daemon_kill");
+    const fs::path sessions = dir / "sessions";
+    const fs::path visitor = syntheticVisitorFolder(fs::path(AVATARBOOTH_TEST_WORK_DIR) / "reliability_visitor");
+    const fs::path config = dir / "booth.toml";
+    std::ofstream(config) << "[camera]\nbackend = \"sim\"\nsim_folder = \"" << visitor.string() << "\"\n"
+                          << "[buttons]\nbackend = \"sim\"\n"
+                          << "[display]\nbackend = \"headless\"\nwidth = 640\nheight = 360\n"
+                          << "[screen]\nstrings_file = \"" << AVATARBOOTH_TEST_SOURCE_DIR << "/app/assets/strings.toml\"\n"
+                          << "[flow]\ncountdown_s = 1.0\nsteady_s = 0.0\nthanks_time_s = 1.0\nthanks_min_time_s = 0.0\n"
+                          << "press_guard_s = 0.1\n"
+                          << "[sessions]\ndirectory = \"" << sessions.string() << "\"\n";
+    NotifySocket notify(dir / "notify.sock");
+    const fs::path log = dir / "daemon.log";
+    std::mt19937 rng(20261122);
+
+    std::map<std::string, std::map<std::string, std::uint64_t>> kept;  // code -> fingerprint, as first seen
+    std::vector<double> readySeconds;
+    const int kills = 5;
+    std::size_t fitsSeen = 0;
+    Daemon d = spawnDaemon(config, log, notify);
+    ASSERT_TRUE(notify.waitReady(std::chrono::seconds(30))) << readFile(log);
+    for (int k = 0; k < kills; ++k) {
+        // Alternate: killed while the fit's files are being staged, or at a random moment from the fit's start.
+        const bool duringWrite = k % 2 == 0;
+        const auto deadline = Clock::now() + std::chrono::seconds(60);
+        bool due = false;
+        while (Clock::now() < deadline && !due) {
+            if (duringWrite) due = writingNow(sessions);
+            else due = count(readFile(log), "fitting into") > fitsSeen;
+            if (!due) std::this_thread::sleep_for(std::chrono::milliseconds(duringWrite ? 1 : 20));
+        }
+        if (!due) {  // never leave the daemon running behind a failed test
+            ::kill(d.pid, SIGKILL);
+            ::waitpid(d.pid, nullptr, 0);
+        }
+        ASSERT_TRUE(due) << "no fit seen in 60 s: " << readFile(log);
+        fitsSeen = count(readFile(log), "fitting into");
+        const int delayMs = std::uniform_int_distribution<int>(0, duringWrite ? 120 : 2500)(rng);
+        std::this_thread::sleep_for(std::chrono::milliseconds(delayMs));
+        ::kill(d.pid, SIGKILL);
+        int status = 0;
+        ::waitpid(d.pid, &status, 0);
+        ASSERT_TRUE(WIFSIGNALED(status));
+        std::printf("figure: kill %d %s +%d ms\n", k + 1, duringWrite ? "while staging files" : "after the fit started",
+                    delayMs);
+
+        // What the killed booth left: complete sessions only (pending ones are hidden and removed at restart).
+        const SessionsCheck after = checkSessions(sessions);
+        for (const auto& p : after.problems) ADD_FAILURE() << "after kill " << k + 1 << ": " << p;
+        for (const auto& [code, print] : kept) EXPECT_EQ(fingerprint(sessions / code), print) << code << " changed";
+        for (const auto& code : after.complete)
+            if (!kept.count(code)) kept[code] = fingerprint(sessions / code);
+
+        d = spawnDaemon(config, log, notify);
+        if (!notify.waitReady(std::chrono::seconds(30))) {
+            ::kill(d.pid, SIGKILL);
+            ::waitpid(d.pid, nullptr, 0);
+            FAIL() << "no READY=1 within 30 s of the restart: " << readFile(log);
+        }
+        readySeconds.push_back(Seconds(Clock::now() - d.started).count());
+        EXPECT_EQ(checkSessions(sessions).leftovers, 0) << "the restarted booth did not clear the killed one's leftovers";
+    }
+    // The last one ends normally once it has kept a session.
+    const std::size_t keptBefore = count(readFile(log), "session kept as");
+    const auto deadline = Clock::now() + std::chrono::seconds(90);
+    while (Clock::now() < deadline && count(readFile(log), "session kept as") == keptBefore)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    ::kill(d.pid, SIGTERM);
+    int status = 0;
+    ::waitpid(d.pid, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+
+    const SessionsCheck last = checkSessions(sessions);
+    for (const auto& p : last.problems) ADD_FAILURE() << p;
+    EXPECT_EQ(last.leftovers, 0);
+    EXPECT_GE(last.complete.size(), 1u);
+    for (const auto& [code, print] : kept) EXPECT_EQ(fingerprint(sessions / code), print) << code << " changed";
+    if (haveGltfValidator()) {
+        for (const auto& code : last.complete) {
+            std::string report;
+            EXPECT_TRUE(validateGlb(sessions / code / "avatar.glb", &report)) << code << ": " << report;
+        }
+    }
+    double worst = 0.0;
+    for (double s : readySeconds) worst = std::max(worst, s);
+    std::printf("figure: %d SIGKILLs, %zu sessions complete, restart to READY=1 worst %.2f s\n", kills,
+                last.complete.size(), worst);
+    EXPECT_LT(worst, 2.0);
+}

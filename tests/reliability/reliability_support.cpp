@@ -1,0 +1,151 @@
+// The reliability suite's shared helpers: the fast booth configuration and the sessions-folder checks.
+#include "reliability_support.h"
+
+#include "head/base_head.h"
+#include "render/mesh_renderer.h"
+#include "sim/synthetic_visitor.h"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+
+namespace avatarbooth::reliability {
+namespace fs = std::filesystem;
+
+BoothConfig fastSimBooth(const fs::path& visitorFolder, const fs::path& sessions) {
+    BoothConfig c;
+    c.camera.backend = "sim";
+    c.camera.simFolder = visitorFolder.string();
+    c.camera.simRealTime = true;
+    // A camera that comes back is found again within a second (the reopen back-off is capped here).
+    c.camera.reopenFirstDelaySeconds = 0.2;
+    c.camera.reopenMaxDelaySeconds = 1.0;
+    c.buttons.backend = "sim";
+    c.display.backend = "headless";
+    c.display.width = 640;
+    c.display.height = 360;
+    c.sessions.directory = sessions;
+    // The source tree's strings (the test executables do not sit where the installed booth looks).
+    c.screen.stringsFile = fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "app" / "assets" / "strings.toml";
+    BoothSettings& f = c.flow;
+    f.countdown = Millis(300);
+    f.steadyOk = Millis(200);
+    f.guideAbsentTimeout = Millis(1200);
+    f.guideMaxTime = Millis(30000);
+    f.captureTimeout = Millis(5000);
+    f.processingTimeout = Millis(60000);
+    f.revealTimeout = Millis(1500);
+    f.retakeChoiceTimeout = Millis(5000);
+    f.thanksTime = Millis(400);
+    f.thanksMinTime = Millis(0);
+    f.cameraLostTimeout = Millis(8000);
+    f.pressGuard = Millis(100);
+    return c;
+}
+
+fs::path syntheticVisitorFolder(const fs::path& dir) {
+    const fs::path folder = dir / "synthetic-visitor";
+    if (!fs::exists(folder / "front.jpg") && !fs::exists(folder / "front.png")) {
+        MeshRenderer renderer;
+        const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, SyntheticVisitorOptions{});
+        fs::create_directories(folder);
+        writeSyntheticVisitorFolder(visitor, folder);
+    }
+    return folder;
+}
+
+const std::vector<std::string>& sessionFiles() {
+    static const std::vector<std::string> files = {"avatar.glb",     "fit.json",  "landmarks.json", "session.json",
+                                                   "front.jpg",      "side.jpg",  "preview_front.png"};
+    return files;
+}
+
+namespace {
+
+std::string readAll(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+std::uint32_t le32(const std::string& b, std::size_t at) {
+    return static_cast<std::uint32_t>(static_cast<unsigned char>(b[at])) |
+           static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 1])) << 8 |
+           static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 2])) << 16 |
+           static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 3])) << 24;
+}
+
+// Empty when the folder is a complete session, else what is wrong.
+std::string sessionProblem(const fs::path& folder) {
+    std::error_code ec;
+    if (!fs::is_directory(folder, ec)) return "is not a folder";
+    for (const auto& name : sessionFiles()) {
+        if (!fs::is_regular_file(folder / name, ec)) return "has no " + name;
+        if (fs::file_size(folder / name, ec) == 0) return name + " is empty";
+    }
+    for (const auto& e : fs::directory_iterator(folder))
+        if (e.path().filename().string().find(".tmp-") != std::string::npos)
+            return "holds a temporary file " + e.path().filename().string();
+    for (const char* json : {"fit.json", "session.json", "landmarks.json"})
+        if (nlohmann::json::parse(readAll(folder / json), nullptr, false).is_discarded()) return std::string(json) + " does not parse";
+    const std::string glb = readAll(folder / "avatar.glb");
+    if (glb.size() < 20 || glb.compare(0, 4, "glTF") != 0 || le32(glb, 4) != 2 || le32(glb, 8) != glb.size())
+        return "avatar.glb has a wrong GLB header or length";
+    return {};
+}
+
+}  // namespace
+
+SessionsCheck checkSessions(const fs::path& sessions) {
+    SessionsCheck check;
+    std::error_code ec;
+    if (!fs::is_directory(sessions, ec)) return check;
+    for (const auto& e : fs::directory_iterator(sessions)) {
+        const std::string name = e.path().filename().string();
+        if (name == ".pending") {
+            for (auto it = fs::directory_iterator(e.path(), ec); !ec && it != fs::directory_iterator(); it.increment(ec))
+                ++check.leftovers;
+            continue;
+        }
+        if (name.rfind(".trash-", 0) == 0) {
+            ++check.leftovers;
+            continue;
+        }
+        const std::string problem = sessionProblem(e.path());
+        if (problem.empty()) check.complete.push_back(name);
+        else check.problems.push_back(name + ": " + problem);
+    }
+    return check;
+}
+
+bool haveGltfValidator() {
+    return fs::exists(fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "tests" / "gltf" / "node_modules" / "gltf-validator");
+}
+
+bool validateGlb(const fs::path& glb, std::string* report) {
+    const fs::path validator = fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "tests" / "gltf" / "validate.mjs";
+    const std::string cmd = "node '" + validator.string() + "' '" + glb.string() + "' 2>&1";
+    FILE* pipe = popen(cmd.c_str(), "r");
+    if (!pipe) return false;
+    std::string out;
+    std::array<char, 4096> buf{};
+    while (fgets(buf.data(), static_cast<int>(buf.size()), pipe)) out += buf.data();
+    const bool ok = pclose(pipe) == 0 && out.find("\"errors\":0") != std::string::npos;
+    if (report) *report = out;
+    return ok;
+}
+
+std::map<std::string, std::uint64_t> fingerprint(const fs::path& folder) {
+    std::map<std::string, std::uint64_t> out;
+    for (const auto& e : fs::recursive_directory_iterator(folder)) {
+        if (!e.is_regular_file()) continue;
+        std::uint64_t h = 1469598103934665603ull;
+        for (const char c : readAll(e.path())) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+        out[fs::relative(e.path(), folder).string()] = h;
+    }
+    return out;
+}
+
+}  // namespace avatarbooth::reliability
