@@ -1,8 +1,10 @@
 // Reading booth.toml strictly into the parts' settings structs (toml++ stays inside this file).
 #include "config/booth_config.h"
 
+#include "character/proportions.h"
 #include "common/error.h"
 #include "head/rbf.h"
+#include "stage/tile_stage.h"
 
 #include <toml++/toml.h>
 
@@ -81,6 +83,26 @@ public:
                 fail(n, key, "\"" + v + "\" is not one of " + list(choices));
             out = v;
         }
+    }
+    // An array of words, each one of `choices`, none twice; at least `minCount` of them.
+    bool readWords(const std::string& key, std::vector<std::string>& out, const std::vector<std::string>& choices,
+                   std::size_t minCount) {
+        const toml::node* n = take(key);
+        if (!n) return false;
+        const toml::array* a = n->as_array();
+        if (!a) fail(n, key, "expected a list in brackets of " + list(choices));
+        std::vector<std::string> words;
+        for (const toml::node& e : *a) {
+            if (!e.is_string()) fail(&e, key, "expected words in quotes, each one of " + list(choices));
+            const std::string v = e.as_string()->get();
+            if (std::find(choices.begin(), choices.end(), v) == choices.end())
+                fail(&e, key, "\"" + v + "\" is not one of " + list(choices));
+            if (std::find(words.begin(), words.end(), v) != words.end()) fail(&e, key, "\"" + v + "\" is listed twice");
+            words.push_back(v);
+        }
+        if (words.size() < minCount) fail(n, key, "name at least " + std::to_string(minCount) + " of " + list(choices));
+        out = words;
+        return true;
     }
     // An array of tables ([[key]]), each handed to `each` as a Table of its own.
     template <typename Each>
@@ -331,6 +353,49 @@ void readAnimation(Table t, AnimationSettings& a) {
     t.finish();
 }
 
+void readCharacter(Table t, FitSettings& f) {
+    t.read("enabled", f.characterEnabled);
+    t.read("exaggeration", f.character.exaggeration, 0.0, 3.0);
+    std::vector<std::string> all;
+    for (const SliderRange& r : sliderRanges()) all.emplace_back(r.key);
+    std::vector<std::string> sliders(all);
+    if (f.character.sliders) sliders.assign(f.character.sliders->begin(), f.character.sliders->end());
+    if (t.readWords("sliders", sliders, all, 0)) {
+        f.character.sliders = std::set<std::string>(sliders.begin(), sliders.end());
+        if (f.character.sliders->size() == all.size()) f.character.sliders.reset();  // all of them: the default
+    }
+    std::string colours = f.character.coloursFromPhoto ? "photo" : "fixed";
+    t.readChoice("colours", colours, {"photo", "fixed"});
+    f.character.coloursFromPhoto = colours == "photo";
+    t.read("texture_size", f.character.textureSize, 64, 4096);
+    t.finish();
+}
+
+void readReveal(Table t, RevealSettings& r, bool characterEnabled) {
+    std::vector<std::string> words;
+    for (const AvatarStyle s : r.styles) words.emplace_back(toString(s));
+    if (t.readWords("styles", words, {"photo", "character", "toon"}, 1)) {
+        r.styles.clear();
+        for (const auto& w : words) r.styles.push_back(*parseAvatarStyle(w));
+        // Listed, yet no fit would make it: it would silently never show.
+        if (r.shows(AvatarStyle::Character) && !characterEnabled)
+            t.failHere("styles", "\"character\" is listed but [character] enabled = false (remove it here, or enable it)");
+    } else if (!characterEnabled) {
+        std::erase(r.styles, AvatarStyle::Character);  // the default list, without what is switched off
+    }
+    t.read("toon_colours", r.toonColours, 2, 16);
+    t.read("toon_strip_frames", r.toonStripFrames, 2, 360);
+    t.finish();
+}
+
+void readStage(Table t, StageSettings& s) {
+    t.read("enabled", s.enabled);
+    t.read("map", s.map);
+    t.read("sweep_s", s.sweepSeconds, 2.0, 600.0);
+    t.read("low_angle_deg", s.lowAngleDeg, 0.0, 44.0);
+    t.finish();
+}
+
 }  // namespace
 
 BoothConfig parseBoothConfig(const std::string& text, const std::string& name) {
@@ -353,7 +418,22 @@ BoothConfig parseBoothConfig(const std::string& text, const std::string& name) {
     readGuidance(top.sub("guidance"), config.guidance);
     readSessions(top.sub("sessions"), config.sessions);
     readAnimation(top.sub("animation"), config.animation);
+    readCharacter(top.sub("character"), config.fit.settings);
+    readReveal(top.sub("reveal"), config.reveal, config.fit.settings.characterEnabled);
+    readStage(top.sub("stage"), config.stage);
     top.finish();
+    // A map given in the file is relative to the file (as an operator writes it next to booth.toml).
+    if (!config.stage.map.empty() && config.stage.map.is_relative())
+        config.stage.map = std::filesystem::path(name).parent_path() / config.stage.map;
+    // The operator's map is read now, so a mistake in it stops the booth at start-up with the map's
+    // file:line:column, like a mistake in this file.
+    if (config.stage.enabled && !config.stage.map.empty()) {
+        try {
+            (void)stage::buildStage(stage::loadTileMap(config.stage.map));
+        } catch (const BoothError& e) {
+            throw BoothError(ErrorKind::BadConfig, e.where(), std::string("[stage] map: ") + e.what());
+        }
+    }
     // The screen draws the oval the guidance measures against: one setting, two users.
     config.screen.oval = config.guidance.oval;
     return config;

@@ -102,8 +102,11 @@ ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const Dr
     return model;
 }
 
-cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel, int outlineWidth) {
+cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel, int outlineWidth,
+                   cv::Mat* coverage) {
     cv::Mat canvas(size, CV_8UC3, cv::Scalar(255, 255, 255));
+    cv::Mat mask;
+    if (coverage) mask = cv::Mat::zeros(size, CV_8U);
     const double yaw = std::clamp(std::abs(yawDeg), 0.0, 90.0);
     const double span = model.viewB.direction.thetaDeg - model.viewA.direction.thetaDeg;
     const double t = span != 0.0 ? std::clamp((yaw - model.viewA.direction.thetaDeg) / span, 0.0, 1.0) : 0.0;
@@ -147,12 +150,20 @@ cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double 
         }
         const cv::Vec3d rgb = (1.0 - t) * model.regionsA.regions[p.regionA].colour + t * model.regionsB.regions[p.regionB].colour;
         const cv::Scalar bgr(rgb[2] * 255.0, rgb[1] * 255.0, rgb[0] * 255.0);
-        cv::fillPoly(canvas, std::vector<std::vector<cv::Point>>{poly}, bgr, cv::LINE_AA, kShift);
+        const std::vector<std::vector<cv::Point>> polys{poly};
+        cv::fillPoly(canvas, polys, bgr, cv::LINE_AA, kShift);
         if (outlineWidth > 0)
-            cv::polylines(canvas, std::vector<std::vector<cv::Point>>{poly}, true, cv::Scalar(20, 20, 20), outlineWidth,
-                          cv::LINE_AA, kShift);
+            cv::polylines(canvas, polys, true, cv::Scalar(20, 20, 20), outlineWidth, cv::LINE_AA, kShift);
+        if (coverage) {
+            cv::fillPoly(mask, polys, cv::Scalar(255), cv::LINE_AA, kShift);
+            if (outlineWidth > 0) cv::polylines(mask, polys, true, cv::Scalar(255), outlineWidth, cv::LINE_AA, kShift);
+        }
     }
-    if (yawDeg < 0.0) cv::flip(canvas, canvas, 1);  // the other side: the side drawing mirrored
+    if (yawDeg < 0.0) {  // the other side: the side drawing mirrored
+        cv::flip(canvas, canvas, 1);
+        if (coverage) cv::flip(mask, mask, 1);
+    }
+    if (coverage) *coverage = mask;
     return canvas;
 }
 
@@ -213,19 +224,27 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
     model.backdropPairs = 1;
     return model;
 }
+std::vector<std::pair<std::string, std::string>> turntableFrames(const ToonModel& model, int frames, cv::Size size,
+                                                                 double unitsPerPixel) {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (int i = 0; i < frames; ++i) {
+        const double yaw = frames > 1 ? -90.0 + 180.0 * i / (frames - 1) : 0.0;
+        char name[32];
+        std::snprintf(name, sizeof name, "turntable_%03d.png", i);
+        out.emplace_back(name, encodeImage(renderToon(model, yaw, size, unitsPerPixel), ".png"));
+    }
+    return out;
+}
+
 std::vector<std::filesystem::path> writeTurntable(const ToonModel& model, const std::filesystem::path& directory,
                                                   int frames, cv::Size size, double unitsPerPixel) {
     std::error_code ec;
     std::filesystem::create_directories(directory, ec);
     if (ec) throw BoothError(ErrorKind::Output, directory.string(), "cannot create the folder: " + ec.message());
     std::vector<std::filesystem::path> out;
-    for (int i = 0; i < frames; ++i) {
-        const double yaw = frames > 1 ? -90.0 + 180.0 * i / (frames - 1) : 0.0;
-        char name[32];
-        std::snprintf(name, sizeof name, "turntable_%03d.png", i);
-        const std::filesystem::path path = directory / name;
-        writeFileAtomically(path, encodeImage(renderToon(model, yaw, size, unitsPerPixel), ".png"));
-        out.push_back(path);
+    for (const auto& [name, png] : turntableFrames(model, frames, size, unitsPerPixel)) {
+        writeFileAtomically(directory / name, png);
+        out.push_back(directory / name);
     }
     return out;
 }

@@ -4,6 +4,9 @@
 #include "toon/toon_regions.h"
 
 #include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace avatarbooth::toon {
 
@@ -35,8 +38,10 @@ ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const Dr
 // Renders the billboards orthographically at `yawDeg` in [-90, 90] (0 = front, 90 = view B's side, negative =
 // the other side, drawn mirrored), far regions first, each filled with its colour and outlined dark.
 // `unitsPerPixel` is the render's scale in character units; the origin lands on the image centre.
+// `coverage` (optional) receives a CV_8U mask of what was drawn (255 inside, anti-aliased edges), so the head can be
+// laid over any background.
 cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel,
-                   int outlineWidth = 2);
+                   int outlineWidth = 2, cv::Mat* coverage = nullptr);
 
 // Builds a toon model from a front photo and a side photo with their head masks. The side photo may face either
 // way: `sideNoseImageRight` (SideAnalysis::noseImageRight) says which, and such a photo is mirrored so it looks at
@@ -47,6 +52,9 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
                          const cv::Mat& sideMask, bool sideNoseImageRight, int colours = 6,
                          int headHeightPx = 320);
 
+// The turntable strip in memory: `frames` (file name, PNG bytes) sweeping the yaw from -90 to 90 degrees.
+std::vector<std::pair<std::string, std::string>> turntableFrames(const ToonModel& model, int frames, cv::Size size,
+                                                                 double unitsPerPixel);
 // Writes `frames` PNGs (turntable_000.png …) sweeping the yaw from -90 to 90 degrees into `directory`
 // (created if missing), each file atomically; returns the paths.
 std::vector<std::filesystem::path> writeTurntable(const ToonModel& model, const std::filesystem::path& directory,
