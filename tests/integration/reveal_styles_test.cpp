@@ -86,8 +86,9 @@ TEST(StageView, RendersTheShippedMapOncePerAngleWithItsTileColours) {
     EXPECT_EQ(view.renders(), 2);
     // The low view sees the tops foreshortened and the fronts (brown) more: less green.
     EXPECT_LT(greenShare(low), greenTop - 0.05);
-    cv::imwrite((test::scratchDir("reveal_styles") / "stage_45.png").string(), top);
-    cv::imwrite((test::scratchDir("reveal_styles") / "stage_12.png").string(), low);
+    const std::filesystem::path dir = test::scratchDir("reveal_styles_stage");  // pictures to look at
+    cv::imwrite((dir / "stage_45.png").string(), top);
+    cv::imwrite((dir / "stage_12.png").string(), low);
 }
 
 TEST(StageView, TopDownLookStretchesTheStageByR45) {
@@ -181,8 +182,9 @@ TEST(RevealStyles, CharacterToonAndStageOnTheRevealThenTheStripIsKept) {
         EXPECT_LT(toon, 0.8) << since.count();
         EXPECT_GT(alphaCoverage(in.avatars[1].image), 0.15);
     }
-    cv::imwrite((test::scratchDir("reveal_styles") / "toon.png").string(), in.avatars[2].image);
-    cv::imwrite((test::scratchDir("reveal_styles") / "character.png").string(), in.avatars[1].image);
+    const std::filesystem::path dir = test::scratchDir("reveal_styles");
+    cv::imwrite((dir / "toon.png").string(), in.avatars[2].image);
+    cv::imwrite((dir / "character.png").string(), in.avatars[1].image);
 
     // A held frame reuses the images (no new render).
     const StyleFigures before = styles.figures();
@@ -193,8 +195,7 @@ TEST(RevealStyles, CharacterToonAndStageOnTheRevealThenTheStripIsKept) {
     EXPECT_EQ(after.stageRenders, before.stageRenders);
 
     // Kept: the strip goes into the session folder.
-    const std::filesystem::path session = test::scratchDir("reveal_styles") / "session";
-    std::filesystem::remove_all(session);
+    const std::filesystem::path session = dir / "session";
     std::filesystem::create_directories(session);
     ASSERT_TRUE(styles.writeToonStrip(session));
     for (int i = 0; i < 5; ++i) {
@@ -225,11 +226,11 @@ TEST(RevealStyles, AToonThatCannotBeDrawnSettlesWithoutAPlace) {
     ASSERT_EQ(in.avatars.size(), 1u);
     EXPECT_EQ(in.avatars[0].style, "photo");
     EXPECT_TRUE(in.stage.empty());
-    EXPECT_FALSE(styles.writeToonStrip(test::scratchDir("reveal_styles") / "nothing"));
+    EXPECT_FALSE(styles.writeToonStrip(test::scratchDir("reveal_styles_nothing")));
 }
 
 TEST(RevealStyles, ABrokenStageMapIsAConfigErrorWithLineAndColumn) {
-    const std::filesystem::path map = test::scratchDir("reveal_styles") / "broken.map";
+    const std::filesystem::path map = test::scratchDir("reveal_styles_map") / "broken.map";
     {
         std::ofstream(map) << "ggg\ngxg\n";
     }
