@@ -464,7 +464,8 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         // Before the first visitor, the attract screen turns the base head (skin-coloured, untextured).
         const auto base = configuredBaseHead(config.fit);
         stage.show(base->mesh, cv::Mat(8, 8, CV_8UC3, cv::Scalar(150, 170, 210)));
-        styles = std::make_unique<RevealStyles>(config.reveal, config.stage, config.animation, *base, 480);
+        // 400: the side styles' places are about 400 px wide on a 1280x720 screen (fewer pixels for llvmpipe).
+        styles = std::make_unique<RevealStyles>(config.reveal, config.stage, config.animation, *base, 400);
     }
 
     // --- The flow.

@@ -348,7 +348,9 @@ void RevealStyles::fill(ScreenInputs& in, bool reveal, std::chrono::milliseconds
         const double elevation =
             stage::sweepElevation(std::chrono::duration<double>(since).count(), s.stageSettings.sweepSeconds,
                                   s.stageSettings.lowAngleDeg);
-        in.stage = s.stage->render(elevation, layout.stage.size());
+        // At half the band's resolution, scaled up by the screen: flat-coloured boxes lose little, and llvmpipe
+        // (fill-rate bound) draws a quarter of the pixels on the frames the camera moves.
+        in.stage = s.stage->render(elevation, cv::Size(std::max(1, layout.stage.width / 2), std::max(1, layout.stage.height / 2)));
         if (s.stage->renders() != before) {
             remember(s.stageMs, s.stage->lastRenderMilliseconds());
             ++s.figures.stageRenders;
