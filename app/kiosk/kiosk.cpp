@@ -15,6 +15,7 @@
 #include "drivers/gpio/clock.h"
 #include "drivers/gpio/lamps.h"
 #include "face/landmarks68.h"
+#include "kiosk/reveal_styles.h"
 #include "pipeline/fit_pipeline.h"
 #include "render/mesh_renderer.h"
 #include "screens/screens.h"
@@ -151,6 +152,7 @@ struct FitResult {
     fs::path folder;        // the pending session folder (complete) when ok
     Mesh mesh;
     cv::Mat texture;
+    StyleInputs styles;  // for the reveal's other styles (character head, photos and masks for the toon)
     std::optional<BoothError> error;
 };
 
@@ -300,7 +302,9 @@ private:
                     std::lock_guard lock(s.mutex);
                     s.stage = "export";
                 }
-                s.pipeline->write(outcome, FitInputs{"front.jpg", "side.jpg", {}}, job.out, *renderer);
+                CharacterHead character;
+                s.pipeline->write(outcome, FitInputs{"front.jpg", "side.jpg", {}}, job.out, *renderer, &character);
+                result.styles = styleInputsFrom(outcome, std::move(character));
                 result.ok = true;
                 result.folder = job.out;
                 result.mesh = outcome.fit.mesh;
@@ -559,10 +563,13 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     PreviewWorker previews(config.guidance, *detectorMutex);
     bool detectorGiven = false;
     AvatarStage stage(config.animation, 480);
+    std::unique_ptr<RevealStyles> styles;
     {
         // Before the first visitor, the attract screen turns the base head (skin-coloured, untextured).
         const auto base = configuredBaseHead(config.fit);
         stage.show(base->mesh, cv::Mat(8, 8, CV_8UC3, cv::Scalar(150, 170, 210)));
+        // 400: the side styles' places are about 400 px wide on a 1280x720 screen (fewer pixels for llvmpipe).
+        styles = std::make_unique<RevealStyles>(config.reveal, config.stage, config.animation, *base, 400);
     }
 
     // --- The flow.
@@ -574,6 +581,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     std::uint64_t fitJob = 0;
     bool fitWanted = false;   // StartFit received, waiting for the preview analysis to let go of the detector
     fs::path pendingFolder;   // the current fit's output, until kept or discarded
+    bool saveWanted = false;  // SaveSession received, waiting for the toon to be drawn (its strip goes with it)
     std::string cameraProblem;
     std::string sessionId;
     ScreenId lastScreen = flow.screen().id;
@@ -629,17 +637,9 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                     ++fitJob;  // its result will be dropped
                     fitWanted = false;
                 } else if constexpr (std::is_same_v<T, SaveSession>) {
-                    try {
-                        const std::string code = store.keep(pendingFolder, std::chrono::system_clock::now());
-                        spdlog::info("session kept as {}", code);
-                        report.keptCodes.push_back(code);
-                        pendingFolder.clear();
-                        events.push_back(SessionSaved{code, now});
-                    } catch (const BoothError& e) {
-                        spdlog::error("session not kept: {}", e.what());
-                        events.push_back(SessionSaveFailed{e.what(), now});
-                    }
+                    saveWanted = true;  // kept below, once the toon (drawn in the background) can go with it
                 } else if constexpr (std::is_same_v<T, DiscardSession>) {
+                    saveWanted = false;
                     if (!pendingFolder.empty()) {
                         try {
                             store.discard(pendingFolder);
@@ -758,12 +758,29 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                 if (result->ok) store.discard(result->folder);
             } else if (result->ok) {
                 stage.show(result->mesh, result->texture);
+                styles->visitor(std::move(result->styles));
                 events.push_back(FitDone{now});
             } else {
                 spdlog::warn("fit failed: {}", result->error->what());
                 if (!pendingFolder.empty() && fs::exists(pendingFolder)) store.discard(pendingFolder);
                 pendingFolder.clear();
                 events.push_back(fitFailureFor(*result->error, now));
+            }
+        }
+
+        // Keeping the session, with the toon's strip in it: the thanks screen says "saving" until then.
+        if (saveWanted && styles->toonSettled()) {
+            saveWanted = false;
+            try {
+                if (!pendingFolder.empty()) styles->writeToonStrip(pendingFolder);
+                const std::string code = store.keep(pendingFolder, std::chrono::system_clock::now());
+                spdlog::info("session kept as {}", code);
+                report.keptCodes.push_back(code);
+                pendingFolder.clear();
+                events.push_back(SessionSaved{code, now});
+            } catch (const BoothError& e) {
+                spdlog::error("session not kept: {}", e.what());
+                events.push_back(SessionSaveFailed{e.what(), now});
             }
         }
 
@@ -795,8 +812,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         const bool previewScreen = screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide ||
                                    screen.id == ScreenId::Countdown;
         if (previewScreen) inputs.preview = lastPreview;
-        if (screen.id == ScreenId::Reveal || screen.id == ScreenId::Attract)
+        if (screen.id == ScreenId::Reveal || screen.id == ScreenId::Attract) {
             inputs.avatar = stage.frame(screen.id == ScreenId::Reveal, screen.sinceEntered);
+            styles->fill(inputs, screen.id == ScreenId::Reveal, screen.sinceEntered, screens.layout());
+        }
         if (screen.id == ScreenId::RetakeChoice) {
             inputs.frontPhoto = frontPhoto;
             inputs.sidePhoto = sidePhoto;
@@ -845,7 +864,9 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             hintlessGuideShot = -1;
         }
         const bool complete = (!previewScreen || (!inputs.preview.empty() && screen.sinceEntered >= Millis(700))) &&
-                              (screen.id != ScreenId::Reveal || !inputs.avatar.empty()) &&
+                              // (every style drawn; a toon still drawing after 2.5 s is pictured as it is)
+                              (screen.id != ScreenId::Reveal ||
+                               (!inputs.avatar.empty() && (styles->complete() || screen.sinceEntered >= Millis(2500)))) &&
                               (screen.id != ScreenId::Thanks || !screen.code.empty());
         lastScreen = screen.id;
         if (screenshotDue && complete) {
@@ -881,6 +902,15 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     report.analysesPerSecond = guideSeconds > 0.0 ? analyses / guideSeconds : 0.0;
     report.sideCaptureToRevealSeconds = median(captureToReveal);
     report.revealFrameMilliseconds = 1000.0 * median(revealFrameSeconds);
+    const StyleFigures figures = styles->figures();
+    report.characterFrameMilliseconds = figures.characterMs;
+    report.toonFrameMilliseconds = figures.toonMs;
+    report.stageRenderMilliseconds = figures.stageMs;
+    report.toonBuildSeconds = figures.toonBuildSeconds;
+    report.styleFrames = figures.frames;
+    report.characterRenders = figures.characterRenders;
+    report.toonRenders = figures.toonRenders;
+    report.stageRenders = figures.stageRenders;
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     report.peakRssMegabytes = static_cast<double>(usage.ru_maxrss) / 1024.0;
