@@ -1,6 +1,6 @@
 # Install rules and the Debian package (CPack DEB): `cmake --build build/release --target package` writes
 # build/release/avatarbooth_<version>_<arch>.deb. Installed layout (prefix /usr):
-#   /usr/bin/avatarbooth, /etc/avatarbooth/booth.toml (conffile), /usr/share/avatarbooth/strings.toml,
+#   /usr/bin/avatarbooth, /etc/avatarbooth/booth.toml (conffile), /usr/share/avatarbooth/strings.toml + stage.map,
 #   /usr/lib/systemd/system/avatarbooth.service (+ avatarbooth-retention.service/.timer), /usr/lib/tmpfiles.d/avatarbooth.conf,
 #   /usr/lib/sysusers.d/avatarbooth.conf, /usr/lib/udev/rules.d/60-avatarbooth.rules,
 #   /usr/share/avatarbooth/firmware/ (overlay source, .dtbo when dtc was found, config.txt fragment),
@@ -11,13 +11,14 @@
 # The build tree mirrors that layout for the strings file (build/release/app/avatarbooth finds
 # build/release/share/avatarbooth/strings.toml), so the built binary runs from any working directory.
 configure_file(${CMAKE_SOURCE_DIR}/app/assets/strings.toml ${CMAKE_BINARY_DIR}/share/avatarbooth/strings.toml COPYONLY)
+configure_file(${CMAKE_SOURCE_DIR}/app/assets/stage.map ${CMAKE_BINARY_DIR}/share/avatarbooth/stage.map COPYONLY)
 
 # `install` (and cpack's preinstall step) builds nothing: the package test runs cpack on a built tree, and a full
 # rebuild of every target there would take the CI's time.
 set(CMAKE_SKIP_INSTALL_ALL_DEPENDENCY TRUE)
 
 install(TARGETS avatarbooth RUNTIME DESTINATION bin)
-install(FILES ${CMAKE_SOURCE_DIR}/app/assets/strings.toml DESTINATION share/avatarbooth)
+install(FILES ${CMAKE_SOURCE_DIR}/app/assets/strings.toml ${CMAKE_SOURCE_DIR}/app/assets/stage.map DESTINATION share/avatarbooth)
 # The config lives in /etc whatever the prefix: it is the operator's file (a dpkg conffile, kept on upgrade).
 install(FILES ${CMAKE_SOURCE_DIR}/app/assets/booth.toml DESTINATION /etc/avatarbooth)
 install(FILES ${CMAKE_SOURCE_DIR}/systemd/avatarbooth.service ${CMAKE_SOURCE_DIR}/systemd/avatarbooth-retention.service

@@ -151,7 +151,9 @@ CharacterHead makeCharacterHead(const BaseHead& base, const CharacterProportions
     CharacterProportions target = wanted;
     for (const SliderRange& s : sliderRanges()) {
         const double b = proportionQuantity(out.base, s.quantity);
-        setProportionQuantity(target, s.quantity, b + settings.exaggeration * (proportionQuantity(wanted, s.quantity) - b));
+        const bool applied = !settings.sliders || settings.sliders->count(std::string(s.key)) > 0;
+        setProportionQuantity(target, s.quantity,
+                              applied ? b + settings.exaggeration * (proportionQuantity(wanted, s.quantity) - b) : b);
     }
     out.target = target = clampToSliderRanges(target);
     const double eyeDistance = glm::distance(xy(featureMean(base.mesh, base, 36, 41)), xy(featureMean(base.mesh, base, 42, 47)));

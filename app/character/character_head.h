@@ -19,6 +19,10 @@
 
 #include <opencv2/core.hpp>
 
+#include <optional>
+#include <set>
+#include <string>
+
 namespace avatarbooth {
 
 // Flat colours of the painted character (BGR).
@@ -34,6 +38,11 @@ struct CharacterSettings {
     double exaggeration = 1.0;  // 1: the given proportions; above 1 pushes each away from the base head's (caricature)
     int correctionRounds = 4;   // measure-and-correct rounds of the deformation
     double pxPerMm = 4.0;       // resolution of the silhouette the head is measured on
+    // The sliders (SliderRange::key) that move the character's parts; a slider left out keeps the base head's
+    // value, so an operator can keep, say, the eyes generic and play only with the face shape. Unset: all of them.
+    std::optional<std::set<std::string>> sliders;
+    // Skin and hair colours sampled from the photo (lookFromPhoto), or the fixed CharacterLook palette.
+    bool coloursFromPhoto = true;
 };
 
 // A head mesh seen as a front photo: its orthographic front silhouette and projected feature vertices.

@@ -21,12 +21,18 @@ CharacterOutputs makeCharacterOutputs(const cv::Mat& frontPhoto, const std::arra
     input.earHole = earHole;
     const NaritaMapping mapping = mapNaritaPoints(input);
     const CharacterProportions proportions = computeProportions(mapping.points);
-    const CharacterHead head = makeCharacterHead(base, proportions, settings, lookFromPhoto(frontPhoto, landmarks, frontMask));
+    const CharacterLook look = settings.coloursFromPhoto ? lookFromPhoto(frontPhoto, landmarks, frontMask) : CharacterLook{};
+    CharacterHead head = makeCharacterHead(base, proportions, settings, look);
 
     nlohmann::json j = characterJson(mapping, proportions);
     nlohmann::json character;
     character["file"] = "character.glb";
     character["exaggeration"] = settings.exaggeration;
+    character["colours"] = settings.coloursFromPhoto ? "photo" : "fixed";
+    nlohmann::json applied = nlohmann::json::array();
+    for (const SliderRange& s : sliderRanges())
+        if (!settings.sliders || settings.sliders->count(std::string(s.key))) applied.push_back(s.key);
+    character["sliders_applied"] = applied;
     for (const auto& [name, value] : std::map<std::string, const CharacterProportions*>{
              {"target", &head.target}, {"achieved", &head.achieved}, {"base_head", &head.base}}) {
         nlohmann::json ratios;
@@ -44,6 +50,7 @@ CharacterOutputs makeCharacterOutputs(const cv::Mat& frontPhoto, const std::arra
     out.json = j.dump(2) + "\n";
     out.glb = encodeGlb(head.mesh, head.texture, "character");
     out.warnings = mapping.warnings;
+    out.head = std::move(head);
     return out;
 }
 

@@ -18,6 +18,7 @@ struct CharacterOutputs {
     std::string json;                   // character.json, pretty-printed
     std::string glb;                    // character.glb bytes
     std::vector<std::string> warnings;  // for fit.json (ears estimated, temples cut by the frame, ...)
+    CharacterHead head;                 // the head itself (mesh and painted texture), for the kiosk's reveal
 };
 
 // The side photo's ear hole carried into the front photo through the fit's shared heights (its x is the head's

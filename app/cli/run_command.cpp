@@ -149,6 +149,11 @@ void registerRunCommand(CLI::App& app) {
                     report.sideCaptureToRevealSeconds, report.revealFrameMilliseconds,
                     report.revealFrameMilliseconds > 0.0 ? 1000.0 / report.revealFrameMilliseconds : 0.0,
                     report.peakRssMegabytes);
+        std::printf("styles: character %.1f ms (%d renders), toon %.1f ms (%d renders), stage %.1f ms (%d renders) over "
+                    "%d attract/reveal frames; toon drawn in %.2f s\n",
+                    report.characterFrameMilliseconds, report.characterRenders, report.toonFrameMilliseconds,
+                    report.toonRenders, report.stageRenderMilliseconds, report.stageRenders, report.styleFrames,
+                    report.toonBuildSeconds);
         if (kioskLeftAThreadRunning()) endLeavingTheModelLoad(kExitOk);
     });
 }

@@ -4,6 +4,7 @@
 
 #include "common/error.h"
 #include "config/config_schema.h"
+#include "stage/tile_stage.h"
 
 #include <toml++/toml.h>
 
@@ -76,6 +77,23 @@ public:
                 if (!(v >= k.min && v <= k.max))
                     fail(n, k.name, "must be between " + num(k.min) + " and " + num(k.max) + ", got " + num(v));
                 return v;
+            }
+            case ConfigType::WordList: {
+                const toml::array* a = n->as_array();
+                if (!a) fail(n, k.name, "expected a list in brackets of " + list(k.choices));
+                std::vector<std::string> words;
+                for (const toml::node& e : *a) {
+                    if (!e.is_string()) fail(&e, k.name, "expected words in quotes, each one of " + list(k.choices));
+                    const std::string v = e.as_string()->get();
+                    if (std::find(k.choices.begin(), k.choices.end(), v) == k.choices.end())
+                        fail(&e, k.name, "\"" + v + "\" is not one of " + list(k.choices));
+                    if (std::find(words.begin(), words.end(), v) != words.end())
+                        fail(&e, k.name, "\"" + v + "\" is listed twice");
+                    words.push_back(v);
+                }
+                if (words.size() < k.minCount)
+                    fail(n, k.name, "name at least " + std::to_string(k.minCount) + " of " + list(k.choices));
+                return words;
             }
         }
         fail(n, k.name, "has a type the schema does not know");
@@ -215,6 +233,27 @@ BoothConfig parseBoothConfig(const std::string& text, const std::string& name) {
     config.file = name;
     Table top(&root, "", name, 1);
     readTable(top, "", nullptr, config, 0);
+    // [reveal] styles and [character] enabled: a style listed that no fit would make would silently never show;
+    // not listed at all, the default list drops what is switched off.
+    if (!config.fit.settings.characterEnabled && config.reveal.shows(AvatarStyle::Character)) {
+        if (const toml::node* styles = root.at_path("reveal.styles").node())
+            throw BoothError(ErrorKind::BadConfig, name + ":" + std::to_string(styles->source().begin.line),
+                             "reveal.styles: \"character\" is listed but [character] enabled = false (remove it "
+                             "here, or enable it)");
+        std::erase(config.reveal.styles, AvatarStyle::Character);
+    }
+    // A map given in the file is relative to the file (as an operator writes it next to booth.toml).
+    if (!config.stage.map.empty() && config.stage.map.is_relative())
+        config.stage.map = std::filesystem::path(name).parent_path() / config.stage.map;
+    // The operator's map is read now, so a mistake in it stops the booth at start-up with the map's
+    // file:line:column, like a mistake in this file.
+    if (config.stage.enabled && !config.stage.map.empty()) {
+        try {
+            (void)stage::buildStage(stage::loadTileMap(config.stage.map));
+        } catch (const BoothError& e) {
+            throw BoothError(ErrorKind::BadConfig, e.where(), std::string("[stage] map: ") + e.what());
+        }
+    }
     // The screen draws the oval the guidance measures against: one setting, two users.
     config.screen.oval = config.guidance.oval;
     return config;

@@ -15,6 +15,7 @@
 #include "drivers/display/display_settings.h"
 #include "drivers/gpio/gpio_settings.h"
 #include "head/base_head.h"
+#include "kiosk/style_settings.h"
 #include "pipeline/fit_pipeline.h"
 #include "screens/screens.h"
 
@@ -42,6 +43,9 @@ struct BoothConfig {
     GuidanceSettings guidance;   // [guidance]
     SessionStoreSettings sessions;  // [sessions]
     AnimationSettings animation;    // [animation]
+    // [character] fills fit.settings.characterEnabled and fit.settings.character.
+    RevealSettings reveal;          // [reveal]
+    StageSettings stage;            // [stage]
 };
 
 // Reads and checks a configuration file. Throws BoothError(BadConfig) with "FILE:LINE: key: what is wrong", or

@@ -1,6 +1,7 @@
 // Every table and key of booth.toml, and the default file and Markdown reference rendered from them.
 #include "config/config_schema.h"
 
+#include "character/proportions.h"
 #include "head/rbf.h"
 
 #include <charconv>
@@ -122,6 +123,66 @@ ConfigKey enumChoice(std::string table, std::string name, Ref ref, std::vector<s
     return k;
 }
 
+// A list of words, each one of `choices`, none twice, at least `minCount`; `get`/`set` translate to the field.
+template <typename Get, typename Set>
+ConfigKey words(std::string table, std::string name, std::vector<std::string> choices, std::size_t minCount, Get get,
+                Set set, std::string doc) {
+    ConfigKey k{.table = std::move(table), .name = std::move(name), .type = ConfigType::WordList,
+                .choices = std::move(choices), .minCount = minCount, .doc = std::move(doc)};
+    k.get = [get](const BoothConfig& c, std::size_t) { return ConfigValue(get(c)); };
+    k.set = [set](BoothConfig& c, std::size_t, const ConfigValue& v) { set(c, std::get<std::vector<std::string>>(v)); };
+    return k;
+}
+
+std::vector<std::string> sliderKeys() {
+    std::vector<std::string> keys;
+    for (const SliderRange& r : sliderRanges()) keys.emplace_back(r.key);
+    return keys;
+}
+
+std::vector<std::string> styleNames() {
+    std::vector<std::string> names;
+    for (const AvatarStyle s : {AvatarStyle::Photo, AvatarStyle::Character, AvatarStyle::Toon}) names.emplace_back(toString(s));
+    return names;
+}
+
+// [character] sliders: unset means all of them; a set is listed in sliderRanges() order.
+ConfigKey characterSliders() {
+    return words(
+        "character", "sliders", sliderKeys(), 0,
+        [](const BoothConfig& c) {
+            const auto& chosen = c.fit.settings.character.sliders;
+            std::vector<std::string> out;
+            for (const std::string& key : sliderKeys())
+                if (!chosen || chosen->count(key)) out.push_back(key);
+            return out;
+        },
+        [](BoothConfig& c, const std::vector<std::string>& v) {
+            auto& sliders = c.fit.settings.character.sliders;
+            sliders = std::set<std::string>(v.begin(), v.end());
+            if (sliders->size() == sliderRanges().size()) sliders.reset();  // all of them: the default
+        },
+        "The sliders that move the character; one left out keeps the base head's value ([] = none of them).");
+}
+
+ConfigKey revealStyles() {
+    return words(
+        "reveal", "styles", styleNames(), 1,
+        [](const BoothConfig& c) {
+            std::vector<std::string> out;
+            for (const AvatarStyle s : c.reveal.styles) out.emplace_back(toString(s));
+            return out;
+        },
+        [](BoothConfig& c, const std::vector<std::string>& v) {
+            c.reveal.styles.clear();
+            for (const std::string& w : v) c.reveal.styles.push_back(*parseAvatarStyle(w));  // checked: a choice
+        },
+        "The styles side by side, most important first (the first is drawn largest, in the middle; the next left of "
+        "it, the next right): \"photo\" (the photo-fitted head), \"character\", \"toon\" (Kitamura's two-view "
+        "drawing, made from the photos while the reveal already shows). Not given, \"character\" is left out while "
+        "[character] is disabled; listed while it is disabled, it is an error.");
+}
+
 const char* biasName(LineBias bias) {
     switch (bias) {
         case LineBias::PullUp: return "pull-up";
@@ -237,6 +298,12 @@ std::vector<ConfigTable> makeTables() {
                                           "sessions would be deleted before their photos' retention ends"};
                  }});
     t.push_back({.name = "animation", .doc = "The avatar's turn on the reveal and attract screens."});
+    t.push_back({.name = "character",
+                 .doc = "The character avatar (issue 6): a stylised head made from the base head, its face parts moved "
+                        "and scaled to the visitor's proportions (Narita); written as character.json + character.glb "
+                        "in every session when enabled."});
+    t.push_back({.name = "reveal", .doc = "The avatar styles on the reveal and attract screens."});
+    t.push_back({.name = "stage", .doc = "Kitamura's tile stage under the avatars on the attract and reveal screens."});
     return t;
 }
 
@@ -417,6 +484,39 @@ std::vector<ConfigKey> makeKeys() {
                         "N_io: in-betweens omitted where the motion is fastest."));
     k.push_back(number("animation", "hold_fraction", FIELD(animation.holdFraction), 0.0, 0.9,
                        "N_hf: the share of the frames held."));
+    // [character]
+    k.push_back(flag("character", "enabled", FIELD(fit.settings.characterEnabled),
+                     "Make the character in every fit (character.json + character.glb in the session)."));
+    k.push_back(number("character", "exaggeration", FIELD(fit.settings.character.exaggeration), 0.0, 3.0,
+                       "1: the measured proportions; above 1 exaggerates each away from the base head's (caricature), "
+                       "below 1 tones down."));
+    k.push_back(characterSliders());
+    k.push_back(enumChoice(
+        "character", "colours", FIELD(fit.settings.character.coloursFromPhoto), {"photo", "fixed"},
+        [](bool fromPhoto) { return fromPhoto ? "photo" : "fixed"; },
+        [](const std::string& s) { return s == "photo"; },
+        "\"photo\": skin and hair colours sampled from the front photo; \"fixed\": the built-in palette."));
+    k.push_back(integer("character", "texture_size", FIELD(fit.settings.character.textureSize), 64, 4096,
+                        "Edge of the painted (flat-colour) texture in texels."));
+    // [reveal]
+    k.push_back(revealStyles());
+    k.push_back(integer("reveal", "toon_colours", FIELD(reveal.toonColours), 2, 16, "Flat colours of the toon drawing."));
+    k.push_back(integer("reveal", "toon_strip_frames", FIELD(reveal.toonStripFrames), 2, 360,
+                        "Frames of the toon's turntable strip kept in the session (toon/turntable_NNN.png)."));
+    // [stage]
+    k.push_back(flag("stage", "enabled", FIELD(stage.enabled), "Show the tile stage under the avatars."));
+    k.push_back(path("stage", "map", FIELD(stage.map),
+                     "The tile map (format in the shipped stage.map); \"\" = the one the booth ships. A relative path "
+                     "is taken from the folder of this file; a mistake in the map stops the booth with MAP:LINE:COLUMN."));
+    {
+        ConfigKey sweep = number("stage", "sweep_s", FIELD(stage.sweepSeconds), 2.0, 600.0,
+                                 "One camera sweep: the top-down look (45 degrees), down to low_angle_deg (ordinary "
+                                 "3-D), and back.");
+        sweep.type = ConfigType::Seconds;
+        k.push_back(std::move(sweep));
+    }
+    k.push_back(number("stage", "low_angle_deg", FIELD(stage.lowAngleDeg), 0.0, 44.0,
+                       "The camera's elevation in degrees at the ordinary 3-D end of the sweep."));
     return k;
 }
 
@@ -470,6 +570,28 @@ std::string decimal(double v) {
     return s.str();
 }
 
+// "key = value\n"; a list too long for one line continues on lines indented under its first element.
+std::string keyLine(const std::string& key, const ConfigValue& value) {
+    const std::string line = key + " = " + tomlValue(value);
+    const auto* list = std::get_if<std::vector<std::string>>(&value);
+    if (!list || line.size() <= kWidth) return line + "\n";
+    const std::string indent(key.size() + 4, ' ');
+    std::string out = key + " = [", current = out;
+    for (std::size_t i = 0; i < list->size(); ++i) {
+        const std::string word = quoted((*list)[i]) + (i + 1 < list->size() ? "," : "]");
+        if (current.size() > indent.size() && current.size() + 1 + word.size() > kWidth) {
+            out += "\n" + indent;
+            current = indent;
+        } else if (i) {
+            out += " ";
+            current += " ";
+        }
+        out += word;
+        current += word;
+    }
+    return out + "\n";
+}
+
 std::string typeName(ConfigType t) {
     switch (t) {
         case ConfigType::String: return "string";
@@ -480,6 +602,7 @@ std::string typeName(ConfigType t) {
         case ConfigType::Seconds: return "seconds";
         case ConfigType::Choice: return "choice";
         case ConfigType::ButtonCombo: return "buttons";
+        case ConfigType::WordList: return "list";
     }
     return "?";
 }
@@ -502,6 +625,11 @@ std::string allowed(const ConfigKey& k) {
             return s;
         }
         case ConfigType::ButtonCombo: return "`start`, `retake`, `service` joined by `+`";
+        case ConfigType::WordList: {
+            std::string s;
+            for (const auto& c : k.choices) s += (s.empty() ? "" : ", ") + std::string("`") + quoted(c) + "`";
+            return s + "; none twice" + (k.minCount ? ", at least " + std::to_string(k.minCount) : std::string());
+        }
         default: return "";
     }
 }
@@ -528,6 +656,11 @@ std::string tomlValue(const ConfigValue& value) {
     if (const bool* b = std::get_if<bool>(&value)) return *b ? "true" : "false";
     if (const long long* i = std::get_if<long long>(&value)) return std::to_string(*i);
     if (const std::string* s = std::get_if<std::string>(&value)) return quoted(*s);
+    if (const auto* list = std::get_if<std::vector<std::string>>(&value)) {
+        std::string s = "[";
+        for (std::size_t i = 0; i < list->size(); ++i) s += (i ? ", " : "") + quoted((*list)[i]);
+        return s + "]";
+    }
     // The shortest digits that read back as the same double, with a '.' so TOML reads a float.
     char buffer[64];
     const double d = std::get<double>(value);
@@ -551,7 +684,7 @@ std::string renderDefaultConfig() {
         switch (table.kind) {
             case ConfigTableKind::Table:
                 out += "\n[" + table.name + "]\n" + comment(table.doc);
-                for (const ConfigKey* k : keys) out += comment(k->doc) + k->name + " = " + tomlValue(k->get(defaults, 0)) + "\n";
+                for (const ConfigKey* k : keys) out += comment(k->doc) + keyLine(k->name, k->get(defaults, 0));
                 break;
             case ConfigTableKind::Repeated: {
                 out += "\n" + comment(table.doc);

@@ -29,10 +29,11 @@ enum class ConfigType {
     Seconds,      // a duration in seconds (fractions allowed), in [min, max]
     Choice,       // one of `choices`
     ButtonCombo,  // button names joined by "+" ("start+retake")
+    WordList,     // a list of words in brackets, each one of `choices`, none twice, at least `minCount` of them
 };
 
-// A key's value as TOML holds it: bool, integer, floating point or string.
-using ConfigValue = std::variant<bool, long long, double, std::string>;
+// A key's value as TOML holds it: bool, integer, floating point, string or a list of strings.
+using ConfigValue = std::variant<bool, long long, double, std::string, std::vector<std::string>>;
 
 // Thrown by a key's set() for a value its type and range allow but the setting does not (a combo naming no
 // button); the parser adds the file, line and key.
@@ -73,7 +74,8 @@ struct ConfigKey {
     double min = 0;                     // Integer, Number, Seconds
     double max = 0;
     long long step = 1;                 // Integer: allowed values are min, min + step, ... max
-    std::vector<std::string> choices{};   // Choice
+    std::vector<std::string> choices{};   // Choice, WordList
+    std::size_t minCount = 0;           // WordList: the fewest words
     std::string doc{};
     bool required = false;              // keys of Repeated tables that every element must give
     // The value in a configuration (element: the index in a Repeated table, else 0), and storing a value that has
@@ -92,7 +94,8 @@ std::string renderDefaultConfig();
 // The reference of every key as Markdown tables (what `avatarbooth config --reference` prints; in the README).
 std::string renderConfigReference();
 
-// A value written as TOML writes it (strings quoted and escaped, floating point with a '.' and all its digits).
+// A value written as TOML writes it (strings quoted and escaped, floating point with a '.' and all its digits, a
+// list of strings in brackets on one line).
 std::string tomlValue(const ConfigValue& value);
 
 }  // namespace avatarbooth

@@ -15,6 +15,7 @@
 #include "drivers/gpio/clock.h"
 #include "drivers/gpio/lamps.h"
 #include "face/landmarks68.h"
+#include "kiosk/reveal_styles.h"
 #include "pipeline/fit_pipeline.h"
 #include "render/mesh_renderer.h"
 #include "screens/screens.h"
@@ -151,6 +152,7 @@ struct FitResult {
     fs::path folder;        // the pending session folder (complete) when ok
     Mesh mesh;
     cv::Mat texture;
+    StyleInputs styles;  // for the reveal's other styles (character head, photos and masks for the toon)
     std::optional<BoothError> error;
 };
 
@@ -302,7 +304,9 @@ private:
                 }
                 // No input files: the photos are in memory and are written as JPEGs (file names here would be
                 // read from the working directory).
-                s.pipeline->write(outcome, FitInputs{}, job.out, *renderer);
+                CharacterHead character;
+                s.pipeline->write(outcome, FitInputs{}, job.out, *renderer, &character);
+                result.styles = styleInputsFrom(outcome, std::move(character));
                 result.ok = true;
                 result.folder = job.out;
                 result.mesh = outcome.fit.mesh;
@@ -561,10 +565,13 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     PreviewWorker previews(config.guidance, *detectorMutex);
     bool detectorGiven = false;
     AvatarStage stage(config.animation, 480);
+    std::unique_ptr<RevealStyles> styles;
     {
         // Before the first visitor, the attract screen turns the base head (skin-coloured, untextured).
         const auto base = configuredBaseHead(config.fit);
         stage.show(base->mesh, cv::Mat(8, 8, CV_8UC3, cv::Scalar(150, 170, 210)));
+        // 400: the side styles' places are about 400 px wide on a 1280x720 screen (fewer pixels for llvmpipe).
+        styles = std::make_unique<RevealStyles>(config.reveal, config.stage, config.animation, *base, 400);
     }
 
     // --- The flow.
@@ -576,6 +583,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     std::uint64_t fitJob = 0;
     bool fitWanted = false;   // StartFit received, waiting for the preview analysis to let go of the detector
     fs::path pendingFolder;   // the current fit's output, until kept or discarded
+    bool saveWanted = false;  // SaveSession received, waiting for the toon to be drawn (its strip goes with it)
     std::string cameraProblem;
     std::string sessionId;
     ScreenId lastScreen = flow.screen().id;
@@ -631,25 +639,9 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                     ++fitJob;  // its result will be dropped
                     fitWanted = false;
                 } else if constexpr (std::is_same_v<T, SaveSession>) {
-                    try {
-                        const std::string code = store.keep(pendingFolder, std::chrono::system_clock::now());
-                        spdlog::info("session kept as {}", code);
-                        report.keptCodes.push_back(code);
-                        pendingFolder.clear();
-                        events.push_back(SessionSaved{code, now});
-                    } catch (const BoothError& e) {
-                        spdlog::error("session not kept: {}", e.what());
-                        events.push_back(SessionSaveFailed{e.what(), now});
-                        // Nothing of a session that could not be kept stays behind (the flow sends no discard
-                        // after a keep, and the next fit would reuse pendingFolder).
-                        try {
-                            if (!pendingFolder.empty()) store.discard(pendingFolder);
-                        } catch (const BoothError& d) {
-                            spdlog::error("discarding the session that was not kept: {}", d.what());
-                        }
-                        pendingFolder.clear();
-                    }
+                    saveWanted = true;  // kept below, once the toon (drawn in the background) can go with it
                 } else if constexpr (std::is_same_v<T, DiscardSession>) {
+                    saveWanted = false;
                     if (!pendingFolder.empty()) {
                         try {
                             store.discard(pendingFolder);
@@ -786,12 +778,37 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                 if (result->ok) store.discard(result->folder);
             } else if (result->ok) {
                 stage.show(result->mesh, result->texture);
+                styles->visitor(std::move(result->styles));
                 events.push_back(FitDone{now});
             } else {
                 spdlog::warn("fit failed: {}", result->error->what());
                 if (!pendingFolder.empty() && fs::exists(pendingFolder)) store.discard(pendingFolder);
                 pendingFolder.clear();
                 events.push_back(fitFailureFor(*result->error, now));
+            }
+        }
+
+        // Keeping the session, with the toon's strip in it: the thanks screen says "saving" until then.
+        if (saveWanted && styles->toonSettled()) {
+            saveWanted = false;
+            try {
+                if (!pendingFolder.empty()) styles->writeToonStrip(pendingFolder);
+                const std::string code = store.keep(pendingFolder, std::chrono::system_clock::now());
+                spdlog::info("session kept as {}", code);
+                report.keptCodes.push_back(code);
+                pendingFolder.clear();
+                events.push_back(SessionSaved{code, now});
+            } catch (const BoothError& e) {
+                spdlog::error("session not kept: {}", e.what());
+                events.push_back(SessionSaveFailed{e.what(), now});
+                // Nothing of a session that could not be kept stays behind (the flow sends no discard after a
+                // keep, and the next fit would reuse pendingFolder).
+                try {
+                    if (!pendingFolder.empty()) store.discard(pendingFolder);
+                } catch (const BoothError& d) {
+                    spdlog::error("discarding the session that was not kept: {}", d.what());
+                }
+                pendingFolder.clear();
             }
         }
 
@@ -823,8 +840,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         const bool previewScreen = screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide ||
                                    screen.id == ScreenId::Countdown;
         if (previewScreen) inputs.preview = lastPreview;
-        if (screen.id == ScreenId::Reveal || screen.id == ScreenId::Attract)
+        if (screen.id == ScreenId::Reveal || screen.id == ScreenId::Attract) {
             inputs.avatar = stage.frame(screen.id == ScreenId::Reveal, screen.sinceEntered);
+            styles->fill(inputs, screen.id == ScreenId::Reveal, screen.sinceEntered, screens.layout());
+        }
         if (screen.id == ScreenId::RetakeChoice) {
             inputs.frontPhoto = frontPhoto;
             inputs.sidePhoto = sidePhoto;
@@ -873,7 +892,9 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             hintlessGuideShot = -1;
         }
         const bool complete = (!previewScreen || (!inputs.preview.empty() && screen.sinceEntered >= Millis(700))) &&
-                              (screen.id != ScreenId::Reveal || !inputs.avatar.empty()) &&
+                              // (every style drawn; a toon still drawing after 2.5 s is pictured as it is)
+                              (screen.id != ScreenId::Reveal ||
+                               (!inputs.avatar.empty() && (styles->complete() || screen.sinceEntered >= Millis(2500)))) &&
                               (screen.id != ScreenId::Thanks || !screen.code.empty());
         lastScreen = screen.id;
         if (screenshotDue && complete) {
@@ -909,6 +930,15 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     report.analysesPerSecond = guideSeconds > 0.0 ? analyses / guideSeconds : 0.0;
     report.sideCaptureToRevealSeconds = median(captureToReveal);
     report.revealFrameMilliseconds = 1000.0 * median(revealFrameSeconds);
+    const StyleFigures figures = styles->figures();
+    report.characterFrameMilliseconds = figures.characterMs;
+    report.toonFrameMilliseconds = figures.toonMs;
+    report.stageRenderMilliseconds = figures.stageMs;
+    report.toonBuildSeconds = figures.toonBuildSeconds;
+    report.styleFrames = figures.frames;
+    report.characterRenders = figures.characterRenders;
+    report.toonRenders = figures.toonRenders;
+    report.stageRenders = figures.stageRenders;
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     report.peakRssMegabytes = static_cast<double>(usage.ru_maxrss) / 1024.0;

@@ -54,6 +54,12 @@ struct KioskReport {
     double sideCaptureToRevealSeconds = 0.0;      // the side photo taken -> the avatar on the reveal screen
     double revealFrameMilliseconds = 0.0;         // one reveal frame: avatar render + screen + present
     double peakRssMegabytes = 0.0;                // of the whole process (getrusage)
+    // The reveal's other styles (medians over the frames that drew them; held frames reuse the last image).
+    double characterFrameMilliseconds = 0.0;      // one character render
+    double toonFrameMilliseconds = 0.0;           // one toon billboard render
+    double stageRenderMilliseconds = 0.0;         // one stage render (only when the camera angle changed)
+    double toonBuildSeconds = 0.0;                // drawing the toon from the photos (background thread)
+    int styleFrames = 0, characterRenders = 0, toonRenders = 0, stageRenders = 0;
 };
 
 // Runs the booth until options.sessions have ended or options.stop is set. Throws BoothError when a device or the

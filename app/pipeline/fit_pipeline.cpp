@@ -180,7 +180,7 @@ cv::Mat drawSideOverlayWithRays(const FitOutcome& o) {
 }
 
 std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& inputs, const fs::path& outDir,
-                                         MeshRenderer& renderer) const {
+                                         MeshRenderer& renderer, CharacterHead* characterOut) const {
     StagedDirectory dir(outDir, "fit.json");
     const fs::path s = dir.staging();
     std::vector<fs::path> written;
@@ -228,10 +228,13 @@ std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& i
 
     // Character maker (issue 6, app/character/): Narita's proportions and the stylised character head.
     const auto tCharacter = Clock::now();
-    const CharacterOutputs character = makeCharacterOutputs(o.front, o.frontLandmarks.points, o.frontMask,
-                                                            earHoleInFrontPhoto(o.fit, o.sideLandmarks), base_);
-    put("character.json", character.json);
-    put("character.glb", character.glb);
+    CharacterOutputs character;
+    if (settings_.characterEnabled) {
+        character = makeCharacterOutputs(o.front, o.frontLandmarks.points, o.frontMask,
+                                         earHoleInFrontPhoto(o.fit, o.sideLandmarks), base_, settings_.character);
+        put("character.json", character.json);
+        put("character.glb", character.glb);
+    }
     const double characterSeconds = secondsSince(tCharacter);
 
     nlohmann::json report;
@@ -271,6 +274,7 @@ std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& i
     // fit.json last: its presence marks a complete result.
     put("fit.json", report.dump(2) + "\n");
     dir.commit();
+    if (characterOut && settings_.characterEnabled) *characterOut = std::move(character.head);
     return written;
 }
 

@@ -2,6 +2,7 @@
 // read photos -> front landmarks + silhouette -> side profile -> fit -> texture -> previews -> session folder.
 #pragma once
 
+#include "character/character_head.h"
 #include "face/landmarks68.h"
 #include "head/base_head.h"
 #include "head/head_fit.h"
@@ -25,6 +26,9 @@ struct FitSettings {
     HeadFitOptions head = defaultHeadFitOptions();
     PhotoTextureOptions texture;
     int previewSize = 512;
+    // The character avatar (issue 6): character.json + character.glb in every session when enabled ([character]).
+    bool characterEnabled = true;
+    CharacterSettings character;
 };
 
 struct FitInputs {
@@ -74,9 +78,11 @@ public:
                    const FitInputs& names = {}, const StageListener& listener = {}) const;
 
     // Writes the session folder atomically: it is complete, or absent (an earlier result stays as it was).
-    // Returns the paths of what was written. The renderer makes the previews.
+    // Returns the paths of what was written. The renderer makes the previews. The character head made for
+    // character.glb is handed to `character` when given (the kiosk shows it: made once per fit).
     std::vector<std::filesystem::path> write(const FitOutcome& outcome, const FitInputs& inputs,
-                                             const std::filesystem::path& out, MeshRenderer& renderer) const;
+                                             const std::filesystem::path& out, MeshRenderer& renderer,
+                                             CharacterHead* character = nullptr) const;
 
 private:
     FitPipeline(const FitPipeline& shareFrom, std::unique_ptr<LandmarkDetector> detector);

@@ -128,6 +128,8 @@ ScreenRenderer::ScreenRenderer(ScreenSettings settings)
     const int barW = std::min(W - 2 * margin, static_cast<int>(std::lround(760 * L.unit)));
     const int barH = std::max(8, static_cast<int>(std::lround(26 * L.unit)));
     L.progress = cv::Rect((W - barW) / 2, static_cast<int>(std::lround(0.66 * H)), barW, barH);
+    // The stage lies under the avatars' lower half, across the whole width: the heads stand on it.
+    L.stage = rows(0.40, 0.80);
 
     // The background: a vertical gradient, made once.
     background_.create(s, CV_8UC3);
@@ -319,6 +321,79 @@ void ScreenRenderer::drawBanner(const ScreenModel& m) {
 
 // --------------------------------------------------------------------------------------------------- screens
 
+cv::Rect ScreenRenderer::avatarArea(ScreenId screen) const {
+    const ScreenLayout& L = layout_;
+    if (screen == ScreenId::Attract) {
+        const int y = L.top.br().y + static_cast<int>(0.07 * canvas_.rows);  // under the subtitle
+        return cv::Rect(L.middle.x, y, L.middle.width, L.middle.br().y - y);
+    }
+    return cv::Rect(L.middle.x, L.top.br().y, L.middle.width, L.middle.br().y - L.top.br().y);
+}
+
+std::vector<cv::Rect> ScreenRenderer::avatarCells(cv::Rect area, int count) {
+    std::vector<cv::Rect> cells;
+    if (count <= 0 || area.empty()) return cells;
+    if (count == 1) return {area};
+    if (area.width >= area.height) {
+        // Widths: 1.25 for the first, 1 for the others; positions: first in the middle, then left, right, ...
+        const double unit = area.width / (count + 0.25);
+        std::vector<int> order(static_cast<std::size_t>(count));  // left-to-right slot -> avatar index
+        const int middle = (count - 1) / 2;
+        order[static_cast<std::size_t>(middle)] = 0;
+        int left = middle - 1, right = middle + 1;
+        for (int i = 1; i < count; ++i) {
+            const bool goLeft = (i % 2 == 1 && left >= 0) || right >= count;
+            order[static_cast<std::size_t>(goLeft ? left-- : right++)] = i;
+        }
+        cells.resize(static_cast<std::size_t>(count));
+        double x = area.x;
+        for (int slot = 0; slot < count; ++slot) {
+            const int i = order[static_cast<std::size_t>(slot)];
+            const double w = unit * (i == 0 ? 1.25 : 1.0);
+            cells[static_cast<std::size_t>(i)] =
+                cv::Rect(static_cast<int>(std::lround(x)), area.y, static_cast<int>(std::lround(x + w) - std::lround(x)),
+                         area.height);
+            x += w;
+        }
+        return cells;
+    }
+    const int topH = area.height * 2 / 3;
+    cells.emplace_back(area.x, area.y, area.width, topH);
+    const int others = count - 1;
+    for (int i = 0; i < others; ++i) {
+        const int x0 = area.x + area.width * i / others, x1 = area.x + area.width * (i + 1) / others;
+        cells.emplace_back(x0, area.y + topH, x1 - x0, area.height - topH);
+    }
+    return cells;
+}
+
+void ScreenRenderer::drawAvatars(const ScreenInputs& in, ScreenId screen) {
+    const double u = layout_.unit;
+    if (!in.stage.empty()) drawImageFitted(in.stage, layout_.stage);
+    const cv::Rect area = avatarArea(screen);
+    if (in.avatars.empty()) {
+        drawImageFitted(in.avatar, area);
+        return;
+    }
+    const std::vector<cv::Rect> cells = avatarCells(area, static_cast<int>(in.avatars.size()));
+    const bool labelled = in.avatars.size() > 1;
+    for (std::size_t i = 0; i < in.avatars.size(); ++i) {
+        const StyledAvatar& a = in.avatars[i];
+        cv::Rect cell = cells[i];
+        const int labelH = labelled ? static_cast<int>(40 * u) : 0;
+        const cv::Rect label(cell.x, cell.br().y - labelH, cell.width, labelH);
+        cell.height -= labelH;
+        if (a.image.empty()) {
+            drawText(str("style.making"), cell, static_cast<int>(30 * u), kGrey);
+        } else {
+            drawImageFitted(a.image, cell);
+        }
+        const std::string key = "style." + a.style;
+        if (labelled && strings_.has(settings_.language, key))
+            drawText(str(key), label, static_cast<int>(28 * u), kSoftWhite, FontWeight::Bold);
+    }
+}
+
 void ScreenRenderer::attract(const ScreenModel& m, const ScreenInputs& in) {
     const double u = layout_.unit;
     drawBackground();
@@ -327,7 +402,7 @@ void ScreenRenderer::attract(const ScreenModel& m, const ScreenInputs& in) {
     drawText(str("title"), titleBox, static_cast<int>(72 * u), kAccent, FontWeight::Bold);
     const cv::Rect sub(L.top.x, L.top.br().y, L.top.width, static_cast<int>(0.07 * canvas_.rows));
     drawText(str("attract.subtitle"), sub, static_cast<int>(36 * u), kSoftWhite);
-    drawImageFitted(in.avatar, cv::Rect(L.middle.x, sub.br().y, L.middle.width, L.middle.br().y - sub.br().y));
+    drawAvatars(in, ScreenId::Attract);
     // The prompt pulses gently (never disappears: a visitor glancing at the screen always sees it).
     const double phase = static_cast<double>(m.sinceEntered.count() % 1600) / 1600.0;
     const double alpha = 0.75 + 0.25 * std::cos(2 * CV_PI * phase);
@@ -447,7 +522,7 @@ void ScreenRenderer::reveal(const ScreenInputs& in) {
     const double u = layout_.unit;
     drawBackground();
     const ScreenLayout& L = layout_;
-    drawImageFitted(in.avatar, cv::Rect(L.middle.x, L.top.br().y, L.middle.width, L.middle.br().y - L.top.br().y));
+    drawAvatars(in, ScreenId::Reveal);
     drawText(str("reveal.title"), L.top + cv::Point(0, static_cast<int>(10 * u)), static_cast<int>(64 * u), kAccent,
              FontWeight::Bold);
     const bool startLeft = settings_.startButtonOnLeft;

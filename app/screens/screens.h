@@ -46,9 +46,19 @@ struct OperatorInfo {
     RetentionReport lastFreed;  // what the last FreeDisk did
 };
 
+// One style of the avatar (reveal and attract show several side by side).
+struct StyledAvatar {
+    std::string style;  // "photo", "character", "toon": its label is the string "style.<style>"
+    cv::Mat image;      // BGR or BGRA; empty: still being made (the place shows "style.making")
+};
+
 struct ScreenInputs {
     cv::Mat preview;                 // the camera's frame (BGR, not mirrored): guides and countdown
     cv::Mat avatar;                  // the avatar (BGR, or BGRA with coverage as alpha): attract, reveal
+    // Several styles of the avatar, most important first (the first is drawn largest, in the middle); when given,
+    // shown instead of `avatar`.
+    std::vector<StyledAvatar> avatars;
+    cv::Mat stage;                   // the tile stage (BGRA), drawn in ScreenLayout::stage under the avatars
     cv::Mat frontPhoto, sidePhoto;   // the photos taken (BGR; may be empty): the retake question
     OperatorInfo operatorInfo;       // the operator menu
 };
@@ -62,6 +72,7 @@ struct ScreenLayout {
     cv::Rect leftLabel, rightLabel;  // the two button labels inside `bottom`
     cv::Rect code;      // the thanks screen's code box
     cv::Rect progress;  // the processing screen's bar
+    cv::Rect stage;     // attract and reveal: the band the tile stage fills, under the avatars
     double unit = 1.0;  // the text scale: shorter screen side / 720
 };
 
@@ -82,6 +93,13 @@ public:
     const StringTable& strings() const { return strings_; }
     TextRenderer& text() { return *text_; }
 
+    // The area the avatars are drawn in on the attract or reveal screen, and each avatar's place in it when `count`
+    // are shown (avatarCells; the order is the importance order of ScreenInputs::avatars).
+    cv::Rect avatarArea(ScreenId screen) const;
+    // Landscape: a row, the first (a quarter wider) in the middle, the second left of it, the third right, and so
+    // on outwards. Portrait: the first across the top two thirds, the others in a row under it.
+    static std::vector<cv::Rect> avatarCells(cv::Rect area, int count);
+
     // Where a point of a camera frame of size `frame` lands on the screen: the preview is mirrored (the visitor
     // sees a mirror) and scaled to fill the screen, centred, cropping what does not fit.
     cv::Point2d previewToScreen(cv::Point2d cameraPx, cv::Size frame) const;
@@ -94,6 +112,7 @@ private:
                   FontWeight weight = FontWeight::Regular, double alpha = 1.0);
     void drawButtonLabel(const std::string& text, cv::Rect box, bool startButton);
     void drawImageFitted(const cv::Mat& image, cv::Rect box, bool mirror = false);
+    void drawAvatars(const ScreenInputs& in, ScreenId screen);
     void drawProfileOutline(cv::Rect box, bool noseRight, cv::Scalar colour, int thickness);
 
     void attract(const ScreenModel& m, const ScreenInputs& in);

@@ -170,9 +170,13 @@ void drawToon(const ToonModel& model, double yawDeg, cv::Mat& canvas, cv::Mat* a
 
 }  // namespace
 
-cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel, int outlineWidth) {
+cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel, int outlineWidth,
+                   cv::Mat* coverage) {
     cv::Mat canvas(size, CV_8UC3, cv::Scalar(255, 255, 255));
-    drawToon(model, yawDeg, canvas, nullptr, unitsPerPixel, outlineWidth);
+    cv::Mat mask;
+    if (coverage) mask = cv::Mat::zeros(size, CV_8U);
+    drawToon(model, yawDeg, canvas, coverage ? &mask : nullptr, unitsPerPixel, outlineWidth);
+    if (coverage) *coverage = mask;
     return canvas;
 }
 
@@ -272,19 +276,27 @@ ToonModel toonFromPhotoPair(const cv::Mat& frontBgr, const cv::Mat& sideBgr, con
     return toonFromPhotos(frontBgr, frontMask, sideBgr, sideMask, profile.noseImageRight, colours);
 }
 
+std::vector<std::pair<std::string, std::string>> turntableFrames(const ToonModel& model, int frames, cv::Size size,
+                                                                 double unitsPerPixel) {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (int i = 0; i < frames; ++i) {
+        const double yaw = frames > 1 ? -90.0 + 180.0 * i / (frames - 1) : 0.0;
+        char name[32];
+        std::snprintf(name, sizeof name, "turntable_%03d.png", i);
+        out.emplace_back(name, encodeImage(renderToon(model, yaw, size, unitsPerPixel), ".png"));
+    }
+    return out;
+}
+
 std::vector<std::filesystem::path> writeTurntable(const ToonModel& model, const std::filesystem::path& directory,
                                                   int frames, cv::Size size, double unitsPerPixel) {
     std::error_code ec;
     std::filesystem::create_directories(directory, ec);
     if (ec) throw BoothError(ErrorKind::Output, directory.string(), "cannot create the folder: " + ec.message());
     std::vector<std::filesystem::path> out;
-    for (int i = 0; i < frames; ++i) {
-        const double yaw = frames > 1 ? -90.0 + 180.0 * i / (frames - 1) : 0.0;
-        char name[32];
-        std::snprintf(name, sizeof name, "turntable_%03d.png", i);
-        const std::filesystem::path path = directory / name;
-        writeFileAtomically(path, encodeImage(renderToon(model, yaw, size, unitsPerPixel), ".png"));
-        out.push_back(path);
+    for (const auto& [name, png] : turntableFrames(model, frames, size, unitsPerPixel)) {
+        writeFileAtomically(directory / name, png);
+        out.push_back(directory / name);
     }
     return out;
 }

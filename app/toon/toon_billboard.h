@@ -4,6 +4,9 @@
 #include "toon/toon_regions.h"
 
 #include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace avatarbooth::toon {
 
@@ -35,8 +38,10 @@ ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const Dr
 // Renders the billboards orthographically at `yawDeg` in [-90, 90] (0 = front, 90 = view B's side, negative =
 // the other side, drawn mirrored), far regions first, each filled with its colour and outlined dark.
 // `unitsPerPixel` is the render's scale in character units; the origin lands on the image centre.
+// `coverage` (optional) receives a CV_8U mask of what was drawn (255 inside, anti-aliased edges), so the head can be
+// laid over any background.
 cv::Mat renderToon(const ToonModel& model, double yawDeg, cv::Size size, double unitsPerPixel,
-                   int outlineWidth = 2);
+                   int outlineWidth = 2, cv::Mat* coverage = nullptr);
 
 // The radius (character units) of a sphere round the origin that holds every billboard at every yaw: positions and
 // outline reaches at both views (the renderer interpolates between them linearly).
@@ -62,6 +67,10 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
 ToonModel toonFromPhotoPair(const cv::Mat& frontBgr, const cv::Mat& sideBgr, const cv::Mat& plate = cv::Mat(),
                             int colours = 6);
 
+
+// The turntable strip in memory: `frames` (file name, PNG bytes) sweeping the yaw from -90 to 90 degrees.
+std::vector<std::pair<std::string, std::string>> turntableFrames(const ToonModel& model, int frames, cv::Size size,
+                                                                 double unitsPerPixel);
 // Writes `frames` PNGs (turntable_000.png …) sweeping the yaw from -90 to 90 degrees into `directory`
 // (created if missing), each file atomically; returns the paths.
 std::vector<std::filesystem::path> writeTurntable(const ToonModel& model, const std::filesystem::path& directory,

@@ -203,6 +203,11 @@ TEST(Config, SchemaDefaultsAreAllowedValues) {
             if (k.type == ConfigType::Number || k.type == ConfigType::Seconds) {
                 EXPECT_TRUE(std::get<double>(v) >= k.min && std::get<double>(v) <= k.max) << key;
             }
+            if (k.type == ConfigType::WordList) {
+                const auto& list = std::get<std::vector<std::string>>(v);
+                EXPECT_GE(list.size(), k.minCount) << key;
+                for (const auto& w : list) EXPECT_NE(std::find(k.choices.begin(), k.choices.end(), w), k.choices.end()) << key;
+            }
         }
     }
 }
@@ -228,6 +233,10 @@ TEST(Config, EveryKeyLandsInItsSetting) {
                 for (const auto& c : k.choices) candidates.emplace_back(c);
                 break;
             case ConfigType::ButtonCombo: candidates = {std::string("service"), std::string("retake+service")}; break;
+            case ConfigType::WordList:
+                candidates = {std::vector<std::string>{k.choices.back()},
+                              std::vector<std::string>{k.choices.front(), k.choices.back()}};
+                break;
         }
         // A repeated table's element needs its required keys; fit's base head needs both files.
         std::string head = "[" + k.table + "]\n";
@@ -235,6 +244,7 @@ TEST(Config, EveryKeyLandsInItsSetting) {
             head = "[[" + k.table + "]]\n" + (k.name == "name" ? "" : "name = \"start\"\n");
         if (key == "fit.base_mesh") head += "base_features = \"f.json\"\n";
         if (key == "fit.base_features") head += "base_mesh = \"m.glb\"\n";
+        if (key == "stage.map") head += "enabled = false\n";  // an enabled stage reads its map at once
         bool landed = false;
         std::string errors;
         for (const ConfigValue& v : candidates) {

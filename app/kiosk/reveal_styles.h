@@ -1,0 +1,79 @@
+// The avatar styles besides the photo-fitted head on the reveal and attract screens — the character (issue 6) and
+// the two-view toon (issue 7) — and the tile stage under them, as the kiosk's main loop uses them.
+//
+// The kiosk hands each finished fit to visitor(); the character head comes with it (made once, by the pipeline's
+// write), the toon is drawn from the two photos on a worker thread of its own so the screen never waits. Each
+// frame, fill() adds the styles' images (and the stage) to the screen's inputs; every image is kept and reused while
+// the animation holds a pose or the stage camera holds its angle.
+#pragma once
+
+#include "animation/avatar_motion.h"
+#include "head/base_head.h"
+#include "head/mesh.h"
+#include "kiosk/style_settings.h"
+#include "screens/screens.h"
+
+#include <opencv2/core.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace avatarbooth {
+
+struct FitOutcome;
+struct CharacterHead;
+
+// What the styles need of one fit: the photos with their head masks (toon), the character head (character).
+struct StyleInputs {
+    cv::Mat front, frontMask, side, sideMask;
+    bool sideNoseImageRight = true;
+    int sideChinRow = -1;  // the side photo's chin row: both masks are cut there (head only); -1: not cut
+    Mesh characterMesh;    // empty when the character is off
+    cv::Mat characterTexture;
+};
+// Takes what the styles need from a fit (the photos and masks are shared, not copied) and the character head.
+StyleInputs styleInputsFrom(const FitOutcome& outcome, CharacterHead&& character);
+
+// Per-style cost of the last frames, for the benchmark figures (milliseconds, medians over the frames that drew).
+struct StyleFigures {
+    double characterMs = 0.0, toonMs = 0.0, stageMs = 0.0;
+    double toonBuildSeconds = 0.0;  // the last toon drawn from photos
+    int stageRenders = 0, characterRenders = 0, toonRenders = 0, frames = 0;
+};
+
+class RevealStyles {
+public:
+    // `base` shows as the character (painted, neutral proportions) before the first visitor. Throws BoothError
+    // (BadConfig) when the stage map cannot be read or parsed (file:line:column).
+    RevealStyles(const RevealSettings& reveal, const StageSettings& stage, const AnimationSettings& animation,
+                 const BaseHead& base, int avatarSize);
+    ~RevealStyles();
+
+    // A new visitor's fit: shows their character at once and starts drawing their toon (an earlier toon still being
+    // drawn is dropped).
+    void visitor(StyleInputs inputs);
+
+    // Adds to `in` the image of every configured style in order (the photo style is `in.avatar`, which the kiosk
+    // rendered) and the stage, for the reveal (`reveal`) or attract screen `since` it was entered.
+    void fill(ScreenInputs& in, bool reveal, std::chrono::milliseconds since, const ScreenLayout& layout);
+
+    // Whether the last fill() had an image for every style it listed (the toon may still be drawing).
+    bool complete() const { return complete_; }
+    // No toon is being drawn for the current visitor (drawn, failed, or none asked for).
+    bool toonSettled() const;
+    // Writes the current visitor's toon turntable strip into `sessionFolder`/toon (atomically) when there is one.
+    // Returns whether it wrote.
+    bool writeToonStrip(const std::filesystem::path& sessionFolder);
+
+    StyleFigures figures() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    bool complete_ = true;
+};
+
+}  // namespace avatarbooth
