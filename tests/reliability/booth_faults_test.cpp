@@ -130,7 +130,7 @@ TEST(BoothFaults, CameraVanishesMidPreviewAndComesBack) {
     ASSERT_TRUE(back.has_value()) << history(visit);
     const double recovery = Seconds(back->second - *clearedAt).count();
     std::printf("figure: camera back mid-preview -> %s in %.2f s\n", toString(back->first), recovery);
-    EXPECT_LT(recovery, 2.0);
+    EXPECT_LT(recovery, recoveryBoundSeconds());
     EXPECT_EQ(report.keptCodes.size(), 1u) << history(visit);
     EXPECT_EQ(booth.expectOnlyCompleteSessions().size(), 1u);
     // The session ended (the kiosk counts a return to the attract screen, and stops there before the visitor
@@ -159,7 +159,7 @@ TEST(BoothFaults, CameraVanishesMidCaptureAndComesBack) {
     ASSERT_TRUE(guideAgain.has_value()) << history(visit);
     const double recovery = std::max(0.0, Seconds(*guideAgain - *clearedAt).count());
     std::printf("figure: camera back mid-capture -> side_guide in %.2f s\n", recovery);
-    EXPECT_LT(recovery, 2.0) << history(visit);
+    EXPECT_LT(recovery, recoveryBoundSeconds()) << history(visit);
     EXPECT_EQ(report.keptCodes.size(), 1u) << history(visit);
     EXPECT_EQ(booth.expectOnlyCompleteSessions().size(), 1u);
 }
@@ -265,7 +265,7 @@ TEST(BoothFaults, DiskFullWhileTheSessionIsKept) {
     const double seconds = Seconds(*attract - *failedAt).count();
     std::printf("figure: disk full while keeping -> attract %.2f s after the failure was shown (thanks time %.1f s)\n",
                 seconds, Seconds(booth.config.flow.thanksTime).count());
-    EXPECT_LT(seconds, 2.0);
+    EXPECT_LT(seconds, recoveryBoundSeconds());
     const auto codes = booth.expectOnlyCompleteSessions();  // and nothing of the failed session pending
     EXPECT_EQ(codes.size(), 2u);
     EXPECT_NE(std::find(codes.begin(), codes.end(), earlier[0]), codes.end());

@@ -7,10 +7,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <thread>
 
 namespace avatarbooth::reliability {
 namespace fs = std::filesystem;
@@ -30,6 +33,7 @@ BoothConfig fastSimBooth(const fs::path& visitorFolder, const fs::path& sessions
     c.sessions.directory = sessions;
     // The source tree's strings (the test executables do not sit where the installed booth looks).
     c.screen.stringsFile = fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "app" / "assets" / "strings.toml";
+    c.stage.map = fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "app" / "assets" / "stage.map";
     BoothSettings& f = c.flow;
     f.countdown = Millis(300);
     f.steadyOk = Millis(200);
@@ -146,6 +150,16 @@ std::map<std::string, std::uint64_t> fingerprint(const fs::path& folder) {
         out[fs::relative(e.path(), folder).string()] = h;
     }
     return out;
+}
+
+double recoveryBoundSeconds() {
+    double load[1] = {0.0};
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    if (getloadavg(load, 1) == 1 && load[0] > cores) {
+        std::printf("note: load average %.1f on %u cores: the 2 s recovery bound is relaxed to 10 s\n", load[0], cores);
+        return 10.0;
+    }
+    return 2.0;
 }
 
 }  // namespace avatarbooth::reliability
