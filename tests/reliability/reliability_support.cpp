@@ -34,6 +34,10 @@ BoothConfig fastSimBooth(const fs::path& visitorFolder, const fs::path& sessions
     // The source tree's strings (the test executables do not sit where the installed booth looks).
     c.screen.stringsFile = fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "app" / "assets" / "strings.toml";
     c.stage.map = fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "app" / "assets" / "stage.map";
+    // Without the toon: a kept session waits for the toon's drawing, which outlasts these shortened waits and left
+    // sessions unkept and pending between visitors when the styles first joined the flow (to be looked into: see
+    // the closing note); the fault tests are about the camera, the disk and kills.
+    c.reveal.styles = {AvatarStyle::Photo, AvatarStyle::Character};
     BoothSettings& f = c.flow;
     f.countdown = Millis(300);
     f.steadyOk = Millis(200);
