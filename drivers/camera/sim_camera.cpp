@@ -70,7 +70,7 @@ cv::Mat readImage(const fs::path& path) {
     // A small file may declare a huge image: refuse it before the decoder allocates for it.
     const ImageHeader header = readImageHeader(bytes.data(), bytes.size());
     if (header.width <= 0 || header.height <= 0)
-        badFile(path, "declares no image size (damaged header)");
+        badFile(path, "cannot be decoded: its header declares no image size (damaged)");
     if (header.width > kMaxPixels || header.height > kMaxPixels || header.width * header.height > kMaxPixels)
         badFile(path, "is too large (" + std::to_string(header.width) + "x" + std::to_string(header.height) + ")");
     cv::Mat image = cv::imdecode(bytes, cv::IMREAD_COLOR);
