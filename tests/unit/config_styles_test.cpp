@@ -5,6 +5,8 @@
 #include "common/error.h"
 #include "config/booth_config.h"
 
+#include "config_error_of.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -13,15 +15,7 @@ using namespace avatarbooth;
 
 namespace {
 
-std::string errorOf(const std::string& text) {
-    try {
-        parseBoothConfig(text, "booth.toml");
-    } catch (const BoothError& e) {
-        EXPECT_EQ(e.kind(), ErrorKind::BadConfig) << e.what();
-        return e.what();
-    }
-    return "";
-}
+using avatarbooth::test::errorOf;
 
 }  // namespace
 

@@ -7,6 +7,8 @@
 #include "config/config_schema.h"
 #include "common/error.h"
 
+#include "config_error_of.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -30,16 +32,7 @@ std::string readText(const std::filesystem::path& file) {
     return s.str();
 }
 
-// The message of the BadConfig error the text raises ("" when it raises none).
-std::string errorOf(const std::string& text) {
-    try {
-        parseBoothConfig(text, "booth.toml");
-    } catch (const BoothError& e) {
-        EXPECT_EQ(e.kind(), ErrorKind::BadConfig) << e.what();
-        return e.what();
-    }
-    return "";
-}
+using avatarbooth::test::errorOf;
 
 
 // Field by field, every setting the file can hold (independently of the schema's own get()).
