@@ -108,6 +108,21 @@ struct Booth {
     }
 };
 
+// One visitor kept a session before the fault (FaultyVisit with `seed`): its code and the fingerprint of its files,
+// to show afterwards that the fault did not touch it.
+struct EarlierSession {
+    std::string code;
+    std::map<std::string, std::uint64_t> files;
+};
+EarlierSession keepOneSession(Booth& booth, int seed) {
+    FaultyVisit first(nullptr, seed);
+    EXPECT_EQ(booth.run(first, 1).keptCodes.size(), 1u);
+    const auto codes = booth.expectOnlyCompleteSessions();
+    EXPECT_EQ(codes.size(), 1u);
+    if (codes.size() != 1u) return {};
+    return {codes[0], fingerprint(booth.sessions / codes[0])};
+}
+
 }  // namespace
 
 TEST(BoothFaults, CameraVanishesMidPreviewAndComesBack) {
@@ -195,13 +210,8 @@ TEST(BoothFaults, TornAndLateFramesDoNotStopTheBooth) {
 
 TEST(BoothFaults, DiskFullWhileTheSessionIsWritten) {
     Booth booth("disk_full_write");
-    {
-        FaultyVisit first(nullptr, 3);
-        ASSERT_EQ(booth.run(first, 1).keptCodes.size(), 1u);
-    }
-    const auto earlier = booth.expectOnlyCompleteSessions();
-    ASSERT_EQ(earlier.size(), 1u);
-    const auto before = fingerprint(booth.sessions / earlier[0]);
+    const EarlierSession earlier = keepOneSession(booth, 3);
+    ASSERT_FALSE(earlier.code.empty());
 
     bool injected = false;
     std::optional<FlowTime> clearedAt;
@@ -230,18 +240,13 @@ TEST(BoothFaults, DiskFullWhileTheSessionIsWritten) {
     EXPECT_EQ(report.keptCodes.size(), 1u) << history(visit);
     const auto codes = booth.expectOnlyCompleteSessions();
     EXPECT_EQ(codes.size(), 2u);
-    EXPECT_EQ(fingerprint(booth.sessions / earlier[0]), before) << "the earlier session changed";
+    EXPECT_EQ(fingerprint(booth.sessions / earlier.code), earlier.files) << "the earlier session changed";
 }
 
 TEST(BoothFaults, DiskFullWhileTheSessionIsKept) {
     Booth booth("disk_full_keep");
-    {
-        FaultyVisit first(nullptr, 5);
-        ASSERT_EQ(booth.run(first, 1).keptCodes.size(), 1u);
-    }
-    const auto earlier = booth.expectOnlyCompleteSessions();
-    ASSERT_EQ(earlier.size(), 1u);
-    const auto before = fingerprint(booth.sessions / earlier[0]);
+    const EarlierSession earlier = keepOneSession(booth, 5);
+    ASSERT_FALSE(earlier.code.empty());
 
     bool injected = false;
     std::optional<FlowTime> failedAt;
@@ -268,6 +273,6 @@ TEST(BoothFaults, DiskFullWhileTheSessionIsKept) {
     EXPECT_LT(seconds, recoveryBoundSeconds());
     const auto codes = booth.expectOnlyCompleteSessions();  // and nothing of the failed session pending
     EXPECT_EQ(codes.size(), 2u);
-    EXPECT_NE(std::find(codes.begin(), codes.end(), earlier[0]), codes.end());
-    EXPECT_EQ(fingerprint(booth.sessions / earlier[0]), before) << "the earlier session changed";
+    EXPECT_NE(std::find(codes.begin(), codes.end(), earlier.code), codes.end());
+    EXPECT_EQ(fingerprint(booth.sessions / earlier.code), earlier.files) << "the earlier session changed";
 }
