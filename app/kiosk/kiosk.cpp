@@ -1,7 +1,9 @@
 // The kiosk's main loop and its worker threads (model loading + fitting, preview analysis).
 #include "kiosk/kiosk.h"
 
-#include "animation/avatar_motion.h"
+#include "kiosk/avatar_stage.h"
+#include "kiosk/session_writer.h"
+
 #include "booth/guidance.h"
 #include "booth/session_store.h"
 #include "booth/visitor_flow.h"
@@ -16,14 +18,11 @@
 #include "drivers/gpio/lamps.h"
 #include "face/landmarks68.h"
 #include "pipeline/fit_pipeline.h"
-#include "render/mesh_renderer.h"
 #include "screens/screens.h"
 
 #include <spdlog/spdlog.h>
 #include <systemd/sd-daemon.h>
 
-#include <glm/gtc/matrix_transform.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <chrono>
 #include <condition_variable>
@@ -94,72 +93,15 @@ FitFailed fitFailureFor(const BoothError& e, FlowTime t) {
     return f;
 }
 
-// The avatar turning on the reveal and attract screens: the fitted head (or the base head before any visitor),
-// rendered offscreen each frame with the head pose of the keyframed motion (full or limited animation).
-class AvatarStage {
-public:
-    AvatarStage(const AnimationSettings& animation, int size)
-        : size_(size),
-          reveal_(playAnimation(revealMotion(), animation)),
-          attract_(playAnimation(attractMotion(), animation)),
-          fps_(animation.fps) {}
-
-    void show(const Mesh& mesh, const cv::Mat& texture) {
-        renderer_.upload(mesh, texture);
-        glm::dvec3 lo, hi;
-        mesh.bounds(lo, hi);
-        centre_ = (lo + hi) * 0.5;
-        extent_ = glm::length(hi - lo);
-        loaded_ = true;
-    }
-    bool loaded() const { return loaded_; }
-
-    // BGRA: the lit, textured head with its coverage as alpha.
-    cv::Mat frame(bool reveal, Millis since) {
-        if (!loaded_) return {};
-        const auto& clip = reveal ? reveal_ : attract_;
-        if (clip.empty()) return {};
-        const auto index = static_cast<std::size_t>(std::chrono::duration<double>(since).count() * fps_) % clip.size();
-        const glm::dmat4 model = clip[index].headModel;
-        // Turn the camera the other way round the head's centre instead of moving the mesh: one upload per visitor.
-        const glm::dmat4 inverse = glm::inverse(model);
-        const glm::dvec3 eye = glm::dvec3(inverse * glm::dvec4(centre_ + glm::dvec3(0.0, 0.0, 3.0 * extent_), 1.0));
-        const glm::dvec3 target = glm::dvec3(inverse * glm::dvec4(centre_, 1.0));
-        const glm::dvec3 up = glm::normalize(glm::dvec3(inverse * glm::dvec4(0.0, 1.0, 0.0, 0.0)));
-        RenderCamera camera = RenderCamera::orthographic(eye, target, up, extent_ * 0.85 / size_, size_, size_);
-        camera.background = cv::Scalar(0, 0, 0);
-        const RenderResult r = renderer_.render(camera);
-        cv::Mat bgra;
-        cv::cvtColor(r.bgr, bgra, cv::COLOR_BGR2BGRA);
-        cv::Mat channels[4];
-        cv::split(bgra, channels);
-        channels[3] = r.mask;
-        cv::merge(channels, 4, bgra);
-        return bgra;
-    }
-
-private:
-    MeshRenderer renderer_;
-    int size_;
-    std::vector<AnimationFrame> reveal_, attract_;
-    double fps_;
-    glm::dvec3 centre_{0.0};
-    double extent_ = 1.0;
-    bool loaded_ = false;
-};
-
-// What a finished fit hands back to the loop.
+// What a finished fit hands back to the loop: the outcome as soon as it has a mesh and a texture (the session
+// folder is written afterwards by the SessionWriter, behind the reveal).
 struct FitResult {
     std::uint64_t job = 0;
-    bool ok = false;
-    fs::path folder;        // the pending session folder (complete) when ok
-    Mesh mesh;
-    cv::Mat texture;
+    std::shared_ptr<const FitOutcome> outcome;  // when it worked
     std::optional<BoothError> error;
 };
 
-// Loads the landmark model, then fits one job at a time: its own thread, its own offscreen renderer (EGL contexts
-// belong to a thread).
+// Loads the landmark model, then fits one job at a time on its own thread.
 class FitWorker {
 public:
     FitWorker(FitSettings settings, std::shared_ptr<const BaseHead> base, std::mutex& detectorMutex)
@@ -184,10 +126,20 @@ public:
         return loadError_;
     }
 
-    void submit(std::uint64_t job, cv::Mat front, cv::Mat side, fs::path out) {
+    void submit(std::uint64_t job, cv::Mat front, cv::Mat side) {
         {
             std::lock_guard lock(mutex_);
-            job_ = Job{job, std::move(front), std::move(side), std::move(out)};
+            std::erase_if(jobs_, [](const Job& j) { return !j.frontOnly; });  // a queued fit is superseded
+            jobs_.push_back(Job{job, std::move(front), std::move(side), false});
+        }
+        wake_.notify_all();
+    }
+    // Analyses the front photo now (landmarks, silhouette: about a third of the fit), while the visitor turns for
+    // the side photo; the fit of this very photo then starts from it. No result is posted.
+    void analyseFrontAhead(cv::Mat front) {
+        {
+            std::lock_guard lock(mutex_);
+            jobs_.push_back(Job{0, std::move(front), cv::Mat(), true});
         }
         wake_.notify_all();
     }
@@ -206,9 +158,9 @@ public:
 
 private:
     struct Job {
-        std::uint64_t id;
+        std::uint64_t id = 0;
         cv::Mat front, side;
-        fs::path out;
+        bool frontOnly = false;
     };
 
     void run() {
@@ -223,38 +175,48 @@ private:
             loadError_ = e.what();
             return;
         }
-        std::unique_ptr<MeshRenderer> renderer;
+        std::optional<FrontAnalysis> ahead;  // of the last front photo analysed ahead
         for (;;) {
             Job job;
             {
                 std::unique_lock lock(mutex_);
-                wake_.wait(lock, [&] { return quit_ || job_.has_value(); });
+                wake_.wait(lock, [&] { return quit_ || !jobs_.empty(); });
                 if (quit_) return;
-                job = std::move(*job_);
-                job_.reset();
+                job = std::move(jobs_.front());
+                jobs_.pop_front();
+            }
+            if (job.frontOnly) {
+                ahead.reset();
+                try {
+                    std::lock_guard detector(detectorMutex_);
+                    ahead = pipeline_->analyseFront(job.front, cv::Mat(), FitInputs{"front photo", "side photo", {}});
+                    spdlog::info("front photo analysed ahead in {:.0f} ms",
+                                 1000.0 * (ahead->stageSeconds[0].second + ahead->stageSeconds[1].second));
+                } catch (const std::exception& e) {
+                    spdlog::info("front photo not analysed ahead ({}); the fit will say", e.what());
+                }
+                continue;
             }
             FitResult result;
             result.job = job.id;
             try {
-                if (!renderer) renderer = std::make_unique<MeshRenderer>();
                 const FitInputs names{"front photo", "side photo", {}};
-                FitOutcome outcome;
+                auto outcome = std::make_shared<FitOutcome>();
                 {
                     std::lock_guard detector(detectorMutex_);
-                    outcome = pipeline_->fit(job.front, job.side, cv::Mat(), names, [&](const std::string& stage) {
-                        std::lock_guard lock(mutex_);
-                        stage_ = stage;
-                    });
+                    *outcome = pipeline_->fit(
+                        job.front, job.side, cv::Mat(), names,
+                        [&](const std::string& stage) {
+                            std::lock_guard lock(mutex_);
+                            stage_ = stage;
+                        },
+                        ahead ? &*ahead : nullptr);
                 }
-                {
-                    std::lock_guard lock(mutex_);
-                    stage_ = "export";
-                }
-                pipeline_->write(outcome, FitInputs{"front.jpg", "side.jpg", {}}, job.out, *renderer);
-                result.ok = true;
-                result.folder = job.out;
-                result.mesh = outcome.fit.mesh;
-                result.texture = outcome.texture.texture;
+                std::string stages;
+                for (const auto& [name, seconds] : outcome->stageSeconds)
+                    stages += fmt::format("{}{} {:.0f} ms", stages.empty() ? "" : ", ", name, 1000.0 * seconds);
+                spdlog::info("fitted: {}", stages);
+                result.outcome = std::move(outcome);
             } catch (const BoothError& e) {
                 result.error = e;
             } catch (const std::exception& e) {
@@ -272,7 +234,7 @@ private:
     std::condition_variable wake_;
     std::unique_ptr<FitPipeline> pipeline_;
     std::optional<std::string> loadError_;
-    std::optional<Job> job_;
+    std::deque<Job> jobs_;
     std::optional<FitResult> result_;
     std::optional<std::string> stage_;
     bool quit_ = false;
@@ -398,9 +360,13 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
-void writeScreenshot(const fs::path& dir, int index, ScreenId id, const cv::Mat& frame, KioskReport& report) {
-    char name[64];
-    std::snprintf(name, sizeof name, "%02d_%s.png", index, toString(id));
+void writeScreenshot(const fs::path& dir, int index, const ScreenModel& screen, const cv::Mat& frame,
+                     KioskReport& report) {
+    const char* page = "";
+    if (screen.id == ScreenId::OperatorMenu && screen.menuPage == OperatorPage::LastCodes) page = "_last_codes";
+    if (screen.id == ScreenId::OperatorMenu && screen.menuPage == OperatorPage::FreeDisk) page = "_free_disk";
+    char name[80];
+    std::snprintf(name, sizeof name, "%02d_%s%s.png", index, toString(screen.id), page);
     const fs::path path = dir / name;
     try {
         writeFileAtomically(path, encodeImage(frame, ".png"));
@@ -454,7 +420,8 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     FitWorker fitter(config.fit.settings, configuredBaseHead(config.fit), detectorMutex);
     PreviewWorker previews(config.guidance, detectorMutex);
     bool detectorGiven = false;
-    AvatarStage stage(config.animation, 480);
+    AvatarStage stage(config.animation);
+    SessionWriter writer;  // after the fitter: it writes with the fitter's pipeline
     {
         // Before the first visitor, the attract screen turns the base head (skin-coloured, untextured).
         const auto base = configuredBaseHead(config.fit);
@@ -469,10 +436,19 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     std::optional<Photo> previewFor;
     std::uint64_t fitJob = 0;
     bool fitWanted = false;   // StartFit received, waiting for the preview analysis to let go of the detector
-    fs::path pendingFolder;   // the current fit's output, until kept or discarded
+    // The session folder: written in the background after the reveal has started. pendingFolder is the current
+    // visitor's (empty when none); writeJob the write the session waits for (0: none in flight); keepJobs the writes
+    // the visitor has already chosen to keep (kept as soon as they are written); any other write is discarded.
+    fs::path pendingFolder;
+    std::uint64_t writeJob = 0;
+    enum class Written { None, Writing, Done, Failed } written = Written::None;
+    std::string writeFailure;
+    std::vector<std::uint64_t> keepJobs;
     std::string cameraProblem;
     std::string sessionId;
     ScreenId lastScreen = flow.screen().id;
+    OperatorPage lastMenuPage = OperatorPage::Menu;
+    RetentionReport lastFreed;  // what the operator's last "free disk" removed (shown in the menu)
     bool screenshotDue = !options.screenshots.empty();
     int screenshotIndex = 0;
     std::vector<std::pair<Button, FlowTime>> releases;  // simulated presses to release
@@ -480,12 +456,66 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     // Benchmark figures.
     int guideFrames = 0, analyses = 0;
     double guideSeconds = 0.0;
-    std::vector<double> revealFrameSeconds, captureToReveal;
+    std::vector<double> revealFrameSeconds, captureToReveal, revealRenderSeconds, revealComposeSeconds,
+        revealPresentSeconds;
     // (Plain time points with a flag: gcc 12 takes optional<time_point> for maybe-uninitialised here.)
     std::chrono::steady_clock::time_point sideTakenAt{}, lastGuideFrame{};
     bool sideTaken = false, inGuide = false;
     auto lastWatchdog = std::chrono::steady_clock::time_point{};
     bool ready = false;
+
+    const auto discardQuietly = [&](const fs::path& folder) {
+        try {
+            if (!folder.empty()) store.discard(folder);
+        } catch (const BoothError& e) {
+            spdlog::error("discarding {}: {}", folder.string(), e.what());
+        }
+    };
+    // Leaves nothing of the current visitor's folder: removed now when written, else when its write ends.
+    const auto dropSessionFolder = [&] {
+        if (written != Written::Writing) discardQuietly(pendingFolder);
+        pendingFolder.clear();
+        writeJob = 0;
+        written = Written::None;
+    };
+    const auto keepSession = [&](const fs::path& folder, FlowTime now) {
+        try {
+            const std::string code = store.keep(folder, std::chrono::system_clock::now());
+            spdlog::info("session kept as {}", code);
+            report.keptCodes.push_back(code);
+            events.push_back(SessionSaved{code, now});
+        } catch (const BoothError& e) {
+            spdlog::error("session not kept: {}", e.what());
+            discardQuietly(folder);
+            events.push_back(SessionSaveFailed{e.what(), now});
+        }
+    };
+    // A finished background write: kept, held for the visitor's choice, or removed.
+    const auto handleWritten = [&](const SessionWriter::Done& done, FlowTime now) {
+        const auto keep = std::find(keepJobs.begin(), keepJobs.end(), done.job);
+        if (done.error) spdlog::error("the session folder was not written: {}", done.error->what());
+        else spdlog::info("session folder written in {:.2f} s", done.seconds);
+        if (keep != keepJobs.end()) {
+            keepJobs.erase(keep);
+            if (done.error) {
+                discardQuietly(done.folder);
+                events.push_back(SessionSaveFailed{done.error->what(), now});
+            } else {
+                keepSession(done.folder, now);
+            }
+        } else if (done.job == writeJob && written == Written::Writing) {
+            if (done.error) {
+                discardQuietly(done.folder);  // nothing partial stays
+                pendingFolder.clear();
+                written = Written::Failed;
+                writeFailure = done.error->what();
+            } else {
+                written = Written::Done;
+            }
+        } else {
+            discardQuietly(done.folder);  // the visitor retook a photo or left meanwhile
+        }
+    };
 
     const auto execute = [&](const FlowCommand& command, FlowTime now) {
         spdlog::debug("command {}", describe(command));
@@ -509,6 +539,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                         spdlog::info("{} photo taken: {}x{}", c.photo == Photo::Front ? "front" : "side",
                                      still.image.cols, still.image.rows);
                         events.push_back(CaptureDone{c.photo, now});
+                        if (c.photo == Photo::Front && fitter.pipeline()) fitter.analyseFrontAhead(frontPhoto);
                         if (c.photo == Photo::Side) {
                             sideTakenAt = std::chrono::steady_clock::now();
                             sideTaken = true;
@@ -523,25 +554,22 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                     ++fitJob;  // its result will be dropped
                     fitWanted = false;
                 } else if constexpr (std::is_same_v<T, SaveSession>) {
-                    try {
-                        const std::string code = store.keep(pendingFolder, std::chrono::system_clock::now());
-                        spdlog::info("session kept as {}", code);
-                        report.keptCodes.push_back(code);
-                        pendingFolder.clear();
-                        events.push_back(SessionSaved{code, now});
-                    } catch (const BoothError& e) {
-                        spdlog::error("session not kept: {}", e.what());
-                        events.push_back(SessionSaveFailed{e.what(), now});
+                    if (written == Written::Done) {
+                        keepSession(pendingFolder, now);
+                    } else if (written == Written::Writing) {
+                        // Kept as soon as it is written (the thanks screen shows the code then).
+                        spdlog::info("the session is kept once its folder is written");
+                        keepJobs.push_back(writeJob);
+                    } else {
+                        const std::string why = written == Written::Failed ? writeFailure : "no fitted avatar to keep";
+                        spdlog::error("session not kept: {}", why);
+                        events.push_back(SessionSaveFailed{why, now});
                     }
+                    pendingFolder.clear();
+                    writeJob = 0;
+                    written = Written::None;
                 } else if constexpr (std::is_same_v<T, DiscardSession>) {
-                    if (!pendingFolder.empty()) {
-                        try {
-                            store.discard(pendingFolder);
-                        } catch (const BoothError& e) {
-                            spdlog::error("discarding the session: {}", e.what());
-                        }
-                        pendingFolder.clear();
-                    }
+                    dropSessionFolder();
                     frontPhoto.release();
                     sidePhoto.release();
                     ++fitJob;
@@ -562,8 +590,12 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                         else if (name == "flash") lamps.setPattern(name, pattern(c.lamps.flash));
                     }
                 } else if constexpr (std::is_same_v<T, FreeDisk>) {
+                    // Leftovers are every pending folder: a session still being written must be finished first.
+                    writer.waitIdle();
+                    while (auto done = writer.take()) handleWritten(*done, now);
                     const RetentionReport r = store.applyRetention(std::chrono::system_clock::now());
                     const int leftovers = store.removeLeftovers();
+                    lastFreed = r;
                     spdlog::info("operator freed disk: {} photos, {} sessions, {} leftovers, {} bytes", r.photosDeleted,
                                  r.sessionsDeleted, leftovers, r.bytesFreed);
                 }
@@ -589,9 +621,15 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         if (options.visitor) {
             const VisitorScript::Action a = options.visitor->step(flow.screen(), now);
             simControls->setScene(a.scene);
-            if (a.press) {
-                events.push_back(ButtonPressed{*a.press, now});
-                releases.emplace_back(*a.press, now + kReleaseAfter);
+            if (a.cameraPlugged && *a.cameraPlugged != !simControls->vanished()) {
+                spdlog::info("simulated visitor: camera {}", *a.cameraPlugged ? "plugged back" : "unplugged");
+                if (*a.cameraPlugged) simControls->comeBack();
+                else simControls->vanish();
+            }
+            for (const auto& b : {a.press, a.pressWith}) {
+                if (!b) continue;
+                events.push_back(ButtonPressed{*b, now});
+                releases.emplace_back(*b, now + (a.holdFor > Millis(0) ? a.holdFor : kReleaseAfter));
             }
         }
         for (auto it = releases.begin(); it != releases.end();) {
@@ -634,33 +672,40 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
         if (auto analysed = previews.take()) {
             events.push_back(*analysed);
-            ++analyses;
+            // The figure is about the guides (the countdown analyses too, but its frames are not counted).
+            const ScreenId shown = flow.screen().id;
+            if (shown == ScreenId::FrontGuide || shown == ScreenId::SideGuide) ++analyses;
         }
 
         // The fit: started once the model is there and the analysis has let go of the detector.
         if (fitWanted && fitter.pipeline()) {
             previews.drain();
             (void)previews.take();
-            pendingFolder = store.pendingPath();
-            fitter.submit(++fitJob, frontPhoto, sidePhoto, pendingFolder);
-            spdlog::info("fitting into {}", pendingFolder.string());
+            dropSessionFolder();  // a retake: the earlier fit's folder goes
+            fitter.submit(++fitJob, frontPhoto, sidePhoto);
+            spdlog::info("fitting");
             fitWanted = false;
         }
         if (auto stageName = fitter.takeStage()) events.push_back(FitProgress{stageProgress(*stageName), *stageName, now});
         if (auto result = fitter.takeResult()) {
             if (result->job != fitJob) {
-                spdlog::info("a cancelled fit finished; its output is removed");
-                if (result->ok) store.discard(result->folder);
-            } else if (result->ok) {
-                stage.show(result->mesh, result->texture);
+                spdlog::info("a cancelled fit finished; its result is dropped");
+            } else if (result->outcome) {
+                // The reveal starts now; the folder is written behind it.
+                stage.show(result->outcome->fit.mesh, result->outcome->texture.texture);
                 events.push_back(FitDone{now});
+                if (const FitPipeline* p = fitter.pipeline()) {
+                    pendingFolder = store.pendingPath();
+                    writeJob = result->job;
+                    written = Written::Writing;
+                    writer.submit(result->job, result->outcome, p, pendingFolder);
+                }
             } else {
                 spdlog::warn("fit failed: {}", result->error->what());
-                if (!pendingFolder.empty() && fs::exists(pendingFolder)) store.discard(pendingFolder);
-                pendingFolder.clear();
                 events.push_back(fitFailureFor(*result->error, now));
             }
         }
+        while (auto done = writer.take()) handleWritten(*done, now);
 
         // The flow: every event, then a tick for the timeouts and the countdown.
         events.push_back(Tick{now});
@@ -690,8 +735,14 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         const bool previewScreen = screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide ||
                                    screen.id == ScreenId::Countdown;
         if (previewScreen) inputs.preview = lastPreview;
-        if (screen.id == ScreenId::Reveal || screen.id == ScreenId::Attract)
-            inputs.avatar = stage.frame(screen.id == ScreenId::Reveal, screen.sinceEntered);
+        const std::uint64_t rendersBefore = stage.renders();
+        if (screen.id == ScreenId::Reveal || screen.id == ScreenId::Attract) {
+            // Rendered at the size it is shown (no rescaling), and only when the pose changes.
+            const cv::Rect box = screens.avatarBox(screen.id);
+            inputs.avatar = stage.frame(screen.id == ScreenId::Reveal, screen.sinceEntered, std::min(box.width, box.height));
+            inputs.avatarVersion = stage.version();
+        }
+        const auto renderEnd = std::chrono::steady_clock::now();
         if (screen.id == ScreenId::RetakeChoice) {
             inputs.frontPhoto = frontPhoto;
             inputs.sidePhoto = sidePhoto;
@@ -703,8 +754,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             }
             inputs.operatorInfo.sessionsStored = static_cast<int>(store.list().size());
             inputs.operatorInfo.freeBytes = store.freeBytes();
+            inputs.operatorInfo.lastFreed = lastFreed;
         }
         const cv::Mat& drawn = screens.draw(screen, inputs);
+        const auto composeEnd = std::chrono::steady_clock::now();
         display.present(drawn);
         const auto drawEnd = std::chrono::steady_clock::now();
         if (screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide) {
@@ -719,13 +772,18 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
         if (screen.id == ScreenId::Reveal && !inputs.avatar.empty()) {
             revealFrameSeconds.push_back(Seconds(drawEnd - drawStart).count());
+            if (stage.renders() != rendersBefore) revealRenderSeconds.push_back(Seconds(renderEnd - drawStart).count());
+            revealComposeSeconds.push_back(Seconds(composeEnd - renderEnd).count());
+            revealPresentSeconds.push_back(Seconds(drawEnd - composeEnd).count());
             if (sideTaken) {
                 captureToReveal.push_back(Seconds(drawEnd - sideTakenAt).count());
                 sideTaken = false;
             }
         }
-        if (screen.id != lastScreen) {
+        // A new screen, or another page of the operator menu, gets its own screenshot.
+        if (screen.id != lastScreen || (screen.id == ScreenId::OperatorMenu && screen.menuPage != lastMenuPage)) {
             lastScreen = screen.id;
+            lastMenuPage = screen.menuPage;
             screenshotDue = !options.screenshots.empty();
         }
         // A screen's picture once it has what it shows: the preview on guides, the avatar on the reveal.
@@ -733,7 +791,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                               (screen.id != ScreenId::Reveal || !inputs.avatar.empty()) &&
                               (screen.id != ScreenId::Thanks || !screen.code.empty());
         if (screenshotDue && complete) {
-            writeScreenshot(options.screenshots, screenshotIndex++, screen.id, drawn, report);
+            writeScreenshot(options.screenshots, screenshotIndex++, screen, drawn, report);
             screenshotDue = false;
         }
         if (!ready) {
@@ -765,11 +823,22 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     report.analysesPerSecond = guideSeconds > 0.0 ? analyses / guideSeconds : 0.0;
     report.sideCaptureToRevealSeconds = median(captureToReveal);
     report.revealFrameMilliseconds = 1000.0 * median(revealFrameSeconds);
+    report.revealSlowestFrameMilliseconds =
+        revealFrameSeconds.empty() ? 0.0 : 1000.0 * *std::max_element(revealFrameSeconds.begin(), revealFrameSeconds.end());
+    report.revealRenderMilliseconds = 1000.0 * median(revealRenderSeconds);
+    report.revealComposeMilliseconds = 1000.0 * median(revealComposeSeconds);
+    report.revealPresentMilliseconds = 1000.0 * median(revealPresentSeconds);
+    report.revealRenderedShare = revealFrameSeconds.empty() ? 0.0
+        : static_cast<double>(revealRenderSeconds.size()) / static_cast<double>(revealFrameSeconds.size());
+    report.avatarTriangles = stage.triangleCount();
+    report.avatarSamples = stage.samples();
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     report.peakRssMegabytes = static_cast<double>(usage.ru_maxrss) / 1024.0;
-    // Leave nothing of a visitor who was still in the middle of a session.
-    if (!pendingFolder.empty()) store.discard(pendingFolder);
+    // Sessions being written: those kept are kept; nothing of a visitor still in the middle of a session stays.
+    writer.waitIdle();
+    while (auto done = writer.take()) handleWritten(*done, FlowClock::now());
+    dropSessionFolder();
     return report;
 }
 

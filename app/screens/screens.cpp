@@ -146,7 +146,23 @@ cv::Point2d ScreenRenderer::previewToScreen(cv::Point2d p, cv::Size frame) const
     return {W / 2 - (p.x - frame.width / 2.0) * s, H / 2 + (p.y - frame.height / 2.0) * s};
 }
 
+cv::Rect ScreenRenderer::avatarBox(ScreenId id) const {
+    const ScreenLayout& L = layout_;
+    if (id == ScreenId::Reveal) return {L.middle.x, L.top.br().y, L.middle.width, L.middle.br().y - L.top.br().y};
+    if (id == ScreenId::Attract) {
+        const int subBottom = L.top.br().y + static_cast<int>(0.07 * settings_.size.height);
+        return {L.middle.x, subBottom, L.middle.width, L.middle.br().y - subBottom};
+    }
+    return {};
+}
+
 const cv::Mat& ScreenRenderer::draw(const ScreenModel& m, const ScreenInputs& in) {
+    ScreenModel timeless = m;
+    timeless.sinceEntered = Millis(0);
+    if (m.id == ScreenId::Reveal && in.avatarVersion != 0 && revealShown_ &&
+        revealShown_->avatarVersion == in.avatarVersion && revealShown_->model == timeless)
+        return canvas_;  // the very picture drawn last time: the avatar holds its pose
+    revealShown_.reset();
     switch (m.id) {
         case ScreenId::Attract: attract(m, in); break;
         case ScreenId::FrontGuide:
@@ -162,6 +178,8 @@ const cv::Mat& ScreenRenderer::draw(const ScreenModel& m, const ScreenInputs& in
     }
     if (m.id != ScreenId::CameraLost && m.id != ScreenId::OperatorMenu && m.id != ScreenId::CaptureFlash)
         drawBanner(m);
+    if (m.id == ScreenId::Reveal && in.avatarVersion != 0)
+        revealShown_ = RevealShown{in.avatarVersion, timeless};
     return canvas_;
 }
 
@@ -218,9 +236,13 @@ void ScreenRenderer::drawImageFitted(const cv::Mat& image, cv::Rect box, bool mi
     const double s = std::min(static_cast<double>(box.width) / image.cols, static_cast<double>(box.height) / image.rows);
     const cv::Size size(std::max(1, static_cast<int>(image.cols * s)), std::max(1, static_cast<int>(image.rows * s)));
     cv::Mat resized;
-    // Bilinear down to half size (4x cheaper than area averaging, and the images are photos and renders without
-    // fine patterns); area averaging below that, where bilinear would alias.
-    cv::resize(image, resized, size, 0, 0, s < 0.5 ? cv::INTER_AREA : cv::INTER_LINEAR);
+    if (size == image.size() && !mirror) {
+        resized = image;  // rendered at the size shown (the avatar): nothing to scale
+    } else {
+        // Bilinear down to half size (4x cheaper than area averaging, and the images are photos and renders without
+        // fine patterns); area averaging below that, where bilinear would alias.
+        cv::resize(image, resized, size, 0, 0, s < 0.5 ? cv::INTER_AREA : cv::INTER_LINEAR);
+    }
     if (mirror) cv::flip(resized, resized, 1);
     const cv::Rect at(box.x + (box.width - size.width) / 2, box.y + (box.height - size.height) / 2, size.width,
                       size.height);
@@ -236,6 +258,7 @@ void ScreenRenderer::drawImageFitted(const cv::Mat& image, cv::Rect box, bool mi
             uchar* d = dst.ptr(y);
             for (int x = 0; x < src.cols; ++x, s4 += 4, d += 3) {
                 const int a = s4[3];
+                if (a == 0) continue;  // most of an avatar's square is background
                 for (int k = 0; k < 3; ++k) d[k] = static_cast<uchar>((s4[k] * a + d[k] * (255 - a) + 127) / 255);
             }
         }
@@ -327,7 +350,7 @@ void ScreenRenderer::attract(const ScreenModel& m, const ScreenInputs& in) {
     drawText(str("title"), titleBox, static_cast<int>(72 * u), kAccent, FontWeight::Bold);
     const cv::Rect sub(L.top.x, L.top.br().y, L.top.width, static_cast<int>(0.07 * canvas_.rows));
     drawText(str("attract.subtitle"), sub, static_cast<int>(36 * u), kSoftWhite);
-    drawImageFitted(in.avatar, cv::Rect(L.middle.x, sub.br().y, L.middle.width, L.middle.br().y - sub.br().y));
+    drawImageFitted(in.avatar, avatarBox(ScreenId::Attract));
     // The prompt pulses gently (never disappears: a visitor glancing at the screen always sees it).
     const double phase = static_cast<double>(m.sinceEntered.count() % 1600) / 1600.0;
     const double alpha = 0.75 + 0.25 * std::cos(2 * CV_PI * phase);
@@ -444,15 +467,21 @@ void ScreenRenderer::processing(const ScreenModel& m) {
 }
 
 void ScreenRenderer::reveal(const ScreenInputs& in) {
-    const double u = layout_.unit;
-    drawBackground();
-    const ScreenLayout& L = layout_;
-    drawImageFitted(in.avatar, cv::Rect(L.middle.x, L.top.br().y, L.middle.width, L.middle.br().y - L.top.br().y));
-    drawText(str("reveal.title"), L.top + cv::Point(0, static_cast<int>(10 * u)), static_cast<int>(64 * u), kAccent,
-             FontWeight::Bold);
-    const bool startLeft = settings_.startButtonOnLeft;
-    drawButtonLabel(str("reveal.keep"), startLeft ? L.leftLabel : L.rightLabel, true);
-    drawButtonLabel(str("reveal.retake"), startLeft ? L.rightLabel : L.leftLabel, false);
+    if (revealLayer_.empty()) {
+        // Text is the costly part of a screen (FreeType, wrapping): the reveal's never changes, so it is drawn once.
+        const double u = layout_.unit;
+        drawBackground();
+        const ScreenLayout& L = layout_;
+        drawText(str("reveal.title"), L.top + cv::Point(0, static_cast<int>(10 * u)), static_cast<int>(64 * u),
+                 kAccent, FontWeight::Bold);
+        const bool startLeft = settings_.startButtonOnLeft;
+        drawButtonLabel(str("reveal.keep"), startLeft ? L.leftLabel : L.rightLabel, true);
+        drawButtonLabel(str("reveal.retake"), startLeft ? L.rightLabel : L.leftLabel, false);
+        canvas_.copyTo(revealLayer_);
+    } else {
+        revealLayer_.copyTo(canvas_);
+    }
+    drawImageFitted(in.avatar, avatarBox(ScreenId::Reveal));
 }
 
 void ScreenRenderer::retakeChoice(const ScreenInputs& in) {

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,6 +50,9 @@ struct OperatorInfo {
 struct ScreenInputs {
     cv::Mat preview;                 // the camera's frame (BGR, not mirrored): guides and countdown
     cv::Mat avatar;                  // the avatar (BGR, or BGRA with coverage as alpha): attract, reveal
+    // Changes whenever the avatar image changes; 0: unknown (the screen is composed afresh every time). With a
+    // version, a reveal whose avatar has not changed is not composed again.
+    std::uint64_t avatarVersion = 0;
     cv::Mat frontPhoto, sidePhoto;   // the photos taken (BGR; may be empty): the retake question
     OperatorInfo operatorInfo;       // the operator menu
 };
@@ -86,6 +90,10 @@ public:
     // sees a mirror) and scaled to fill the screen, centred, cropping what does not fit.
     cv::Point2d previewToScreen(cv::Point2d cameraPx, cv::Size frame) const;
 
+    // The box the avatar is fitted into on the reveal and attract screens (empty for the others): an avatar image
+    // of min(width, height) pixels square is shown without rescaling.
+    cv::Rect avatarBox(ScreenId id) const;
+
 private:
     void drawBackground();
     void drawPreview(const cv::Mat& preview, bool ovalLit, bool profile);
@@ -119,6 +127,14 @@ private:
         int width = 0, ascent = 0;
     };
     std::map<std::string, BigText> bigText_;  // the countdown's numbers
+    // The reveal without its avatar and banner (background, title, button labels: the same every frame), and what
+    // the canvas holds after the last reveal drawn: its avatar version and banner.
+    cv::Mat revealLayer_;
+    struct RevealShown {
+        std::uint64_t avatarVersion = 0;
+        ScreenModel model;  // with sinceEntered 0: the reveal draws nothing that moves with time but the avatar
+    };
+    std::optional<RevealShown> revealShown_;
     cv::Mat outsideOval_;       // 255 outside the oval, for the last preview size
     cv::Size outsideOvalFor_;   // the preview size outsideOval_ was made for
 };
