@@ -31,12 +31,14 @@ VisitorScript::Action SimVisitor::step(const ScreenModel& screen, FlowTime now) 
     if (script_.operatorFirst && operatorStep_ < 6) {
         // The operator: lock combination held from the attract screen, then through the menu to "free disk"
         // (Retake moves, Start chooses), back (any press), down to "exit" and out.
-        if (operatorStep_ == 0 && screen.id == ScreenId::Attract && in >= Millis(800)) {
+        // (Back on the attract screen without the menu, e.g. the guide timed out: hold the combination again.)
+        if (operatorStep_ <= 1 && screen.id == ScreenId::Attract && in >= Millis(800) && !acted_) {
+            acted_ = true;
             a.press = Button::Start;
             a.pressWith = Button::Retake;
             a.holdFor = script_.lockHold;
             operatorStep_ = 1;
-        } else if (screen.id == ScreenId::OperatorMenu && inPage >= Millis(900) && !acted_) {
+        } else if (screen.id == ScreenId::OperatorMenu && inPage >= Millis(1500) && !acted_) {
             const bool onMenu = screen.menuPage == OperatorPage::Menu;
             if (operatorStep_ == 1 && onMenu && screen.menuItem != OperatorItem::FreeDisk) a.press = Button::Retake;
             else if (operatorStep_ == 1 && onMenu) a.press = Button::Start, operatorStep_ = 2;

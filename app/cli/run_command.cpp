@@ -107,7 +107,7 @@ void registerRunCommand(CLI::App& app) {
                              (o->visitor == "auto" && config.camera.backend == "sim" && simButtons &&
                               config.buttons.timeline.empty());
         SimVisitorScript script = parseSimVisitorScript(o->visitorDoes);
-        script.lockHold = config.flow.lockHold + Millis(300);  // the operator holds the lock just long enough
+        script.lockHold = config.flow.lockHold + Millis(300);  // the operator holds the lock a little longer
         SimVisitor simVisitor(script);
         if (visitor) std::cerr << "avatarbooth: a simulated visitor uses the booth\n";
 
