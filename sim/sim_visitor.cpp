@@ -1,6 +1,10 @@
 // The simulated visitor's behaviour, screen by screen.
 #include "sim/sim_visitor.h"
 
+#include "common/error.h"
+
+#include <sstream>
+
 namespace avatarbooth {
 
 VisitorScript::Action SimVisitor::step(const ScreenModel& screen, FlowTime now) {
@@ -18,6 +22,40 @@ VisitorScript::Action SimVisitor::step(const ScreenModel& screen, FlowTime now) 
             acted_ = true;
         }
     };
+    if (screen.id == ScreenId::OperatorMenu && screen.menuPage != page_) {
+        page_ = screen.menuPage;  // a new page: look at it before pressing again
+        since_ = now;
+        acted_ = false;
+    }
+    const Millis inPage = std::chrono::duration_cast<Millis>(now - since_);
+    if (script_.operatorFirst && operatorStep_ < 6) {
+        // The operator: lock combination held from the attract screen, then through the menu to "free disk"
+        // (Retake moves, Start chooses), back (any press), down to "exit" and out.
+        // (Back on the attract screen without the menu, e.g. the guide timed out: hold the combination again.)
+        if (operatorStep_ <= 1 && screen.id == ScreenId::Attract && in >= Millis(800) && !acted_) {
+            acted_ = true;
+            a.press = Button::Start;
+            a.pressWith = Button::Retake;
+            a.holdFor = script_.lockHold;
+            operatorStep_ = 1;
+        } else if (screen.id == ScreenId::OperatorMenu && inPage >= Millis(1500) && !acted_) {
+            const bool onMenu = screen.menuPage == OperatorPage::Menu;
+            if (operatorStep_ == 1 && onMenu && screen.menuItem != OperatorItem::FreeDisk) a.press = Button::Retake;
+            else if (operatorStep_ == 1 && onMenu) a.press = Button::Start, operatorStep_ = 2;
+            else if (operatorStep_ == 2 && !onMenu) a.press = Button::Start, operatorStep_ = 3;
+            else if (operatorStep_ == 3 && onMenu && screen.menuItem != OperatorItem::ExitMenu) a.press = Button::Retake;
+            else if (operatorStep_ == 3 && onMenu) a.press = Button::Start, operatorStep_ = 6;
+            if (a.press) acted_ = true;
+        }
+        // (Meanwhile the Start of the combination has begun a session: the menu opens once the hold is long enough.)
+        if (screen.id == ScreenId::OperatorMenu && screen.menuItem != lastItem_) {
+            lastItem_ = screen.menuItem;
+            since_ = now;  // moved: look before pressing again
+            acted_ = false;
+        }
+        a.scene = SimScene::Empty;
+        return a;
+    }
     switch (screen.id) {
         case ScreenId::Attract:
             present_ = false;
@@ -27,6 +65,12 @@ VisitorScript::Action SimVisitor::step(const ScreenModel& screen, FlowTime now) 
         case ScreenId::FrontGuide:
         case ScreenId::SideGuide:
             // The guide counts down by itself once it sees a good pose; a visitor left waiting presses Start.
+            if (script_.unplugCameraOnce && !unplugged_ && screen.id == ScreenId::FrontGuide &&
+                in >= script_.unplugAfter) {
+                a.cameraPlugged = false;
+                unplugged_ = true;
+                break;
+            }
             pressOnce(Button::Start, script_.pressIfStuckAfter);
             break;
         case ScreenId::Reveal:
@@ -44,6 +88,12 @@ VisitorScript::Action SimVisitor::step(const ScreenModel& screen, FlowTime now) 
         case ScreenId::Thanks:
             present_ = false;  // walks away with the code
             break;
+        case ScreenId::CameraLost:
+            if (unplugged_ && !pluggedBack_ && in >= script_.plugBackAfter) {
+                a.cameraPlugged = true;
+                pluggedBack_ = true;
+            }
+            break;
         default:
             break;
     }
@@ -54,6 +104,21 @@ VisitorScript::Action SimVisitor::step(const ScreenModel& screen, FlowTime now) 
     // During the reveal and the retake question the visitor faces the screen again.
     if (present_ && (screen.id == ScreenId::Reveal || screen.id == ScreenId::RetakeChoice)) a.scene = SimScene::Front;
     return a;
+}
+
+SimVisitorScript parseSimVisitorScript(const std::string& list) {
+    SimVisitorScript script;
+    std::stringstream in(list);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        if (item == "retake-side") script.retakeSideOnce = true;
+        else if (item == "unplug-camera") script.unplugCameraOnce = true;
+        else if (item == "operator-menu") script.operatorFirst = true;
+        else if (!item.empty())
+            throw BoothError(ErrorKind::BadInput, "--visitor-does",
+                             "unknown item \"" + item + "\" (retake-side, unplug-camera, operator-menu)");
+    }
+    return script;
 }
 
 }  // namespace avatarbooth

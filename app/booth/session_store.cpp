@@ -234,6 +234,17 @@ int SessionStore::removeLeftovers() {
             ++removed;
         }
     }
+    // A kept session gets its toon strip after the keep (the toon may still be drawing then): a half-written one
+    // (".toon.partial-…", see StagedDirectory) is all such a late addition can leave.
+    std::vector<fs::path> partial;
+    for (const StoredSession& kept : list())
+        for (const auto& e : fs::directory_iterator(kept.folder, ec))
+            if (e.path().filename().string().find(".partial-") != std::string::npos) partial.push_back(e.path());
+    for (const fs::path& p : partial) {
+        fs::remove_all(p, ec);
+        if (ec) failOutput(p, "cannot delete: " + ec.message());
+        ++removed;
+    }
     return removed;
 }
 

@@ -88,7 +88,8 @@ public:
     // Applies the retention rules at `now` (the kiosk calls it periodically, e.g. every 10 minutes).
     RetentionReport applyRetention(WallTime now);
 
-    // Deletes what a crash left: every pending fit and every half-deleted session. Returns the folders removed.
+    // Deletes what a crash left: every pending fit, every half-deleted session and any half-written addition to a
+    // kept session (its toon strip). Returns the folders removed.
     int removeLeftovers();
 
     // Kept sessions, newest first.

@@ -119,6 +119,8 @@ std::vector<FlowCommand> VisitorFlow::handle(const FlowEvent& event) {
                        press(e.button, e.t, out);
                    },
                    [&](const ButtonReleased& e) {
+                       // Held long enough up to this release opens the lock, however late the release is seen.
+                       checkLock(e.t, out);
                        down_[idx(e.button)] = false;
                        if (std::find(settings_.lockCombo.begin(), settings_.lockCombo.end(), e.button) !=
                            settings_.lockCombo.end())

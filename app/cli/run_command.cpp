@@ -64,6 +64,7 @@ void registerRunCommand(CLI::App& app) {
         int sessions = 0;
         std::string screenshots;
         std::string visitor = "auto";
+        std::string visitorDoes;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("--config", o->config,
@@ -76,6 +77,10 @@ void registerRunCommand(CLI::App& app) {
                     "yes, no")
         ->check(CLI::IsMember({"auto", "yes", "no"}))
         ->capture_default_str();
+    cmd->add_option("--visitor-does", o->visitorDoes,
+                    "What the simulated visitor does besides one plain session, comma-separated: retake-side (asks "
+                    "to retake the side photo once), unplug-camera (the camera vanishes in the front guide and comes "
+                    "back), operator-menu (an operator opens the menu with the lock first and frees disk)");
     cmd->callback([o] {
         spdlog::set_level(spdlog::get_level() > spdlog::level::info ? spdlog::level::info : spdlog::get_level());
         BoothConfig config;
@@ -114,7 +119,9 @@ void registerRunCommand(CLI::App& app) {
         const bool visitor = o->visitor == "yes" ||
                              (o->visitor == "auto" && config.camera.backend == "sim" && simButtons &&
                               config.buttons.timeline.empty());
-        SimVisitor simVisitor;
+        SimVisitorScript script = parseSimVisitorScript(o->visitorDoes);
+        script.lockHold = config.flow.lockHold + Millis(300);  // the operator holds the lock a little longer
+        SimVisitor simVisitor(script);
         if (visitor) std::cerr << "avatarbooth: a simulated visitor uses the booth\n";
 
         std::signal(SIGINT, onStopSignal);
@@ -155,6 +162,13 @@ void registerRunCommand(CLI::App& app) {
                     report.toonRenders, report.stageRenderMilliseconds, report.stageRenders, report.styleFrames,
                     report.toonBuildSeconds);
         if (kioskLeftAThreadRunning()) endLeavingTheModelLoad(kExitOk);
+        if (report.revealFrameMilliseconds > 0.0)
+            std::printf("reveal frame parts: avatar render %.1f ms (%zu triangles, %d samples, %.0f%% of the frames "
+                        "render; the limited animation holds the others), screen %.1f ms, present %.1f ms; slowest "
+                        "frame %.1f ms\n",
+                        report.revealRenderMilliseconds, report.avatarTriangles, report.avatarSamples,
+                        100.0 * report.revealRenderedShare, report.revealComposeMilliseconds,
+                        report.revealPresentMilliseconds, report.revealSlowestFrameMilliseconds);
     });
 }
 

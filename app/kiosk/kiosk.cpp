@@ -1,7 +1,9 @@
 // The kiosk's main loop and its worker threads (model loading + fitting, preview analysis).
 #include "kiosk/kiosk.h"
 
-#include "animation/avatar_motion.h"
+#include "kiosk/avatar_stage.h"
+#include "kiosk/session_writer.h"
+
 #include "booth/guidance.h"
 #include "booth/session_store.h"
 #include "booth/visitor_flow.h"
@@ -17,7 +19,6 @@
 #include "face/landmarks68.h"
 #include "kiosk/reveal_styles.h"
 #include "pipeline/fit_pipeline.h"
-#include "render/mesh_renderer.h"
 #include "screens/screens.h"
 
 #include <spdlog/spdlog.h>
@@ -38,6 +39,7 @@
 #include <random>
 #include <thread>
 
+#include <malloc.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -91,69 +93,20 @@ FitFailed fitFailureFor(const BoothError& e, FlowTime t) {
     return f;
 }
 
-// The avatar turning on the reveal and attract screens: the fitted head (or the base head before any visitor),
-// rendered offscreen each frame with the head pose of the keyframed motion (full or limited animation).
-class AvatarStage {
-public:
-    AvatarStage(const AnimationSettings& animation, int size)
-        : size_(size),
-          reveal_(playAnimation(revealMotion(), animation)),
-          attract_(playAnimation(attractMotion(), animation)),
-          fps_(animation.fps) {}
-
-    void show(const Mesh& mesh, const cv::Mat& texture) {
-        renderer_.upload(mesh, texture);
-        glm::dvec3 lo, hi;
-        mesh.bounds(lo, hi);
-        centre_ = (lo + hi) * 0.5;
-        extent_ = glm::length(hi - lo);
-        loaded_ = true;
-    }
-    bool loaded() const { return loaded_; }
-
-    // BGRA: the lit, textured head with its coverage as alpha.
-    cv::Mat frame(bool reveal, Millis since) {
-        if (!loaded_) return {};
-        const auto& clip = reveal ? reveal_ : attract_;
-        if (clip.empty()) return {};
-        const auto index = static_cast<std::size_t>(std::chrono::duration<double>(since).count() * fps_) % clip.size();
-        const glm::dmat4 model = clip[index].headModel;
-        // Turn the camera the other way round the head's centre instead of moving the mesh: one upload per visitor.
-        const glm::dmat4 inverse = glm::inverse(model);
-        const glm::dvec3 eye = glm::dvec3(inverse * glm::dvec4(centre_ + glm::dvec3(0.0, 0.0, 3.0 * extent_), 1.0));
-        const glm::dvec3 target = glm::dvec3(inverse * glm::dvec4(centre_, 1.0));
-        const glm::dvec3 up = glm::normalize(glm::dvec3(inverse * glm::dvec4(0.0, 1.0, 0.0, 0.0)));
-        RenderCamera camera = RenderCamera::orthographic(eye, target, up, extent_ * 0.85 / size_, size_, size_);
-        camera.background = cv::Scalar(0, 0, 0);
-        const RenderResult r = renderer_.render(camera);
-        cv::Mat bgra;
-        cv::cvtColor(r.bgr, bgra, cv::COLOR_BGR2BGRA);
-        cv::Mat channels[4];
-        cv::split(bgra, channels);
-        channels[3] = r.mask;
-        cv::merge(channels, 4, bgra);
-        return bgra;
-    }
-
-private:
-    MeshRenderer renderer_;
-    int size_;
-    std::vector<AnimationFrame> reveal_, attract_;
-    double fps_;
-    glm::dvec3 centre_{0.0};
-    double extent_ = 1.0;
-    bool loaded_ = false;
-};
-
-// What a finished fit hands back to the loop.
+// What a finished fit hands back to the loop: the outcome as soon as it has a mesh and a texture (the session
+// folder is written afterwards by the SessionWriter, behind the reveal).
 struct FitResult {
     std::uint64_t job = 0;
-    bool ok = false;
-    fs::path folder;        // the pending session folder (complete) when ok
-    Mesh mesh;
-    cv::Mat texture;
-    StyleInputs styles;  // for the reveal's other styles (character head, photos and masks for the toon)
+    std::shared_ptr<const FitOutcome> outcome;  // when it worked
     std::optional<BoothError> error;
+};
+
+// The character maker's outputs for a fit, made right after it (while the reveal already runs); the session folder
+// is written once they are there (they go into it).
+struct CharacterResult {
+    std::uint64_t job = 0;
+    std::shared_ptr<const CharacterOutputs> outputs;  // null when the character is off or could not be made
+    std::optional<std::string> error;                 // why it could not be made
 };
 
 // Lowers the calling thread's priority (Linux: nice is per thread): the screen and the watchdog come first when
@@ -163,8 +116,8 @@ void lowerThisThreadsPriority(int nice) {
         spdlog::debug("setpriority({}): {}", nice, std::strerror(errno));
 }
 
-// Loads the landmark model on one thread, then fits one job at a time on another (with its own offscreen renderer:
-// EGL contexts belong to a thread). dlib's deserialisation cannot be interrupted (minutes on a slow board or under
+// Loads the landmark model on one thread, then fits one job at a time on another (the session folder is written
+// by the SessionWriter afterwards). dlib's deserialisation cannot be interrupted (minutes on a slow board or under
 // emulation) and the booth must stop within systemd's TimeoutStopSec, so the loading thread is the one thread the
 // kiosk may leave running: everything it uses lives in the State it shares, and a worker destroyed while the model
 // is still loading detaches it instead of joining it (see ~FitWorker and kioskLeftAThreadRunning()).
@@ -209,10 +162,20 @@ public:
         return state_->loadError;
     }
 
-    void submit(std::uint64_t job, cv::Mat front, cv::Mat side, fs::path out) {
+    void submit(std::uint64_t job, cv::Mat front, cv::Mat side) {
         {
             std::lock_guard lock(state_->mutex);
-            state_->job = Job{job, std::move(front), std::move(side), std::move(out)};
+            std::erase_if(state_->jobs, [](const Job& j) { return !j.frontOnly; });  // a queued fit is superseded
+            state_->jobs.push_back(Job{job, std::move(front), std::move(side), false});
+        }
+        state_->wake.notify_all();
+    }
+    // Analyses the front photo now (landmarks, silhouette: about a third of the fit), while the visitor turns for
+    // the side photo; the fit of this very photo then starts from it. No result is posted.
+    void analyseFrontAhead(cv::Mat front) {
+        {
+            std::lock_guard lock(state_->mutex);
+            state_->jobs.push_back(Job{0, std::move(front), cv::Mat(), true});
         }
         state_->wake.notify_all();
     }
@@ -221,6 +184,12 @@ public:
         std::optional<FitResult> r = std::move(state_->result);
         state_->result.reset();
         return r;
+    }
+    std::optional<CharacterResult> takeCharacter() {
+        std::lock_guard lock(state_->mutex);
+        std::optional<CharacterResult> c = std::move(state_->character);
+        state_->character.reset();
+        return c;
     }
     std::optional<std::string> takeStage() {
         std::lock_guard lock(state_->mutex);
@@ -233,9 +202,9 @@ public:
 
 private:
     struct Job {
-        std::uint64_t id;
+        std::uint64_t id = 0;
         cv::Mat front, side;
-        fs::path out;
+        bool frontOnly = false;
     };
     struct State {
         std::shared_ptr<std::mutex> detectorMutex;
@@ -246,9 +215,10 @@ private:
         bool quit = false;
         std::unique_ptr<FitPipeline> pipeline;
         std::optional<std::string> loadError;
-        std::optional<Job> job;
+        std::deque<Job> jobs;  // fits and front photos to analyse ahead, oldest first
         std::optional<FitResult> result;
         std::optional<std::string> stage;
+        std::optional<CharacterResult> character;
     };
 
     static void load(State& s, const FitSettings& settings) {
@@ -275,49 +245,70 @@ private:
     }
 
     static void fit(State& s) {
-        std::unique_ptr<MeshRenderer> renderer;
+        std::optional<FrontAnalysis> ahead;  // of the last front photo analysed ahead
         for (;;) {
             Job job;
             {
                 std::unique_lock lock(s.mutex);
-                s.wake.wait(lock, [&] { return s.quit || (s.pipeline && s.job.has_value()); });
+                s.wake.wait(lock, [&] { return s.quit || (s.pipeline && !s.jobs.empty()); });
                 if (s.quit) return;
-                job = std::move(*s.job);
-                s.job.reset();
+                job = std::move(s.jobs.front());
+                s.jobs.pop_front();
+            }
+            if (job.frontOnly) {
+                ahead.reset();
+                try {
+                    std::lock_guard detector(*s.detectorMutex);
+                    ahead = s.pipeline->analyseFront(job.front, cv::Mat(), FitInputs{"front photo", "side photo", {}});
+                    spdlog::info("front photo analysed ahead in {:.0f} ms",
+                                 1000.0 * (ahead->stageSeconds[0].second + ahead->stageSeconds[1].second));
+                } catch (const std::exception& e) {
+                    spdlog::info("front photo not analysed ahead ({}); the fit will say", e.what());
+                }
+                continue;
             }
             FitResult result;
             result.job = job.id;
             try {
-                if (!renderer) renderer = std::make_unique<MeshRenderer>();
                 const FitInputs names{"front photo", "side photo", {}};
-                FitOutcome outcome;
+                auto outcome = std::make_shared<FitOutcome>();
                 {
                     std::lock_guard detector(*s.detectorMutex);
-                    outcome = s.pipeline->fit(job.front, job.side, cv::Mat(), names, [&](const std::string& stage) {
-                        std::lock_guard lock(s.mutex);
-                        s.stage = stage;
-                    });
+                    *outcome = s.pipeline->fit(
+                        job.front, job.side, cv::Mat(), names,
+                        [&](const std::string& stage) {
+                            std::lock_guard lock(s.mutex);
+                            s.stage = stage;
+                        },
+                        ahead ? &*ahead : nullptr);
                 }
-                {
-                    std::lock_guard lock(s.mutex);
-                    s.stage = "export";
-                }
-                // No input files: the photos are in memory and are written as JPEGs (file names here would be
-                // read from the working directory).
-                CharacterHead character;
-                s.pipeline->write(outcome, FitInputs{}, job.out, *renderer, &character);
-                result.styles = styleInputsFrom(outcome, std::move(character));
-                result.ok = true;
-                result.folder = job.out;
-                result.mesh = outcome.fit.mesh;
-                result.texture = outcome.texture.texture;
+                std::string stages;
+                for (const auto& [name, seconds] : outcome->stageSeconds)
+                    stages += fmt::format("{}{} {:.0f} ms", stages.empty() ? "" : ", ", name, 1000.0 * seconds);
+                spdlog::info("fitted: {}", stages);
+                result.outcome = std::move(outcome);
             } catch (const BoothError& e) {
                 result.error = e;
             } catch (const std::exception& e) {
                 result.error = BoothError(ErrorKind::Internal, "", e.what());
             }
+            const std::shared_ptr<const FitOutcome> fitted = result.outcome;
+            {
+                std::lock_guard lock(s.mutex);
+                s.result = std::move(result);
+                if (s.quit) return;
+            }
+            if (!fitted) continue;
+            // The character next, on this (un-niced) thread: the visitor watches its place on the reveal.
+            CharacterResult character{job.id, nullptr, std::nullopt};
+            try {
+                CharacterOutputs made = s.pipeline->makeCharacter(*fitted);
+                if (!made.json.empty()) character.outputs = std::make_shared<const CharacterOutputs>(std::move(made));
+            } catch (const std::exception& e) {
+                character.error = e.what();
+            }
             std::lock_guard lock(s.mutex);
-            s.result = std::move(result);
+            s.character = std::move(character);
         }
     }
 
@@ -501,10 +492,13 @@ double median(std::vector<double> v) {
 }
 
 // replace: the screen's picture again, over the one written before under this index.
-void writeScreenshot(const fs::path& dir, int index, ScreenId id, const cv::Mat& frame, KioskReport& report,
-                     bool replace = false) {
-    char name[64];
-    std::snprintf(name, sizeof name, "%02d_%s.png", index, toString(id));
+void writeScreenshot(const fs::path& dir, int index, const ScreenModel& screen, const cv::Mat& frame,
+                     KioskReport& report, bool replace = false) {
+    const char* page = "";
+    if (screen.id == ScreenId::OperatorMenu && screen.menuPage == OperatorPage::LastCodes) page = "_last_codes";
+    if (screen.id == ScreenId::OperatorMenu && screen.menuPage == OperatorPage::FreeDisk) page = "_free_disk";
+    char name[80];
+    std::snprintf(name, sizeof name, "%02d_%s%s.png", index, toString(screen.id), page);
     const fs::path path = dir / name;
     try {
         writeFileAtomically(path, encodeImage(frame, ".png"));
@@ -520,6 +514,10 @@ bool kioskLeftAThreadRunning() { return FitWorker::threadLeftRunning.load(); }
 
 KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     const auto startup = std::chrono::steady_clock::now();
+    // glibc gives each new thread's allocations their own arena (up to 8 per core); with the fit, writer, preview
+    // and llvmpipe threads each keeping freed images in its own, the peak RSS of a session measured 43 MB higher
+    // (425 against 382 MB) than with two arenas shared by all.
+    mallopt(M_ARENA_MAX, 2);
     setLogSession("");
     KioskReport report;
     const auto note = [&](const std::string& line) {
@@ -564,15 +562,23 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     FitWorker fitter(config.fit.settings, configuredBaseHead(config.fit), detectorMutex);
     PreviewWorker previews(config.guidance, *detectorMutex);
     bool detectorGiven = false;
-    AvatarStage stage(config.animation, 480);
+    AvatarStage stage(config.animation);
+    SessionWriter writer;  // after the fitter: it writes with the fitter's pipeline
     std::unique_ptr<RevealStyles> styles;
+    // The avatars' places on the reveal: the photo avatar (the first) and the other styles are rendered at the size
+    // they are shown (no rescaling, no more pixels than shown for llvmpipe).
+    const int styleCount = std::max<int>(1, static_cast<int>(config.reveal.styles.size()));
     {
         // Before the first visitor, the attract screen turns the base head (skin-coloured, untextured).
         const auto base = configuredBaseHead(config.fit);
         stage.show(base->mesh, cv::Mat(8, 8, CV_8UC3, cv::Scalar(150, 170, 210)));
-        // 400: the side styles' places are about 400 px wide on a 1280x720 screen (fewer pixels for llvmpipe).
-        styles = std::make_unique<RevealStyles>(config.reveal, config.stage, config.animation, *base, 400);
+        const std::vector<cv::Rect> places = screens.avatarImageBoxes(ScreenId::Reveal, styleCount);
+        const int styleSize = places.size() > 1 ? std::min(places[1].width, places[1].height) : 400;
+        styles = std::make_unique<RevealStyles>(config.reveal, config.stage, config.animation, *base,
+                                                std::max(64, styleSize));
     }
+    std::pair<std::uint64_t, std::uint64_t> shownVersions{0, 0};  // the avatar stage's and the styles' last seen
+    std::uint64_t avatarsVersion = 0;                             // changes with either
 
     // --- The flow.
     VisitorFlow flow(config.flow, FlowClock::now());
@@ -582,12 +588,29 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     std::optional<Photo> previewFor;
     std::uint64_t fitJob = 0;
     bool fitWanted = false;   // StartFit received, waiting for the preview analysis to let go of the detector
-    fs::path pendingFolder;   // the current fit's output, until kept or discarded
-    bool saveWanted = false;  // SaveSession received, waiting for the toon to be drawn (its strip goes with it)
+    // The session folder: written in the background after the reveal has started. pendingFolder is the current
+    // visitor's (empty when none); writeJob the write the session waits for (0: none in flight); keepJobs the writes
+    // the visitor has already chosen to keep (kept as soon as they are written); any other write is discarded.
+    fs::path pendingFolder;
+    std::uint64_t writeJob = 0;
+    enum class Written { None, Writing, Done, Failed } written = Written::None;
+    std::string writeFailure;
+    std::vector<std::uint64_t> keepJobs;
+    std::uint64_t styleJob = 0;  // the fit whose character and toon the styles show
+    // A fitted session whose folder is written once its character is made (the fitter makes it next).
+    struct WriteAfterCharacter {
+        std::uint64_t job = 0;
+        std::shared_ptr<const FitOutcome> outcome;
+        fs::path folder;
+    };
+    std::optional<WriteAfterCharacter> awaitingCharacter;
+    fs::path toonStripFor;       // a kept session whose toon is still being drawn (its strip is added when done)
     std::string cameraProblem;
     std::string sessionId;
     ScreenId lastScreen = flow.screen().id;
     Hint lastHint = Hint::None;
+    OperatorPage lastMenuPage = OperatorPage::Menu;
+    RetentionReport lastFreed;  // what the operator's last "free disk" removed (shown in the menu)
     bool screenshotDue = !options.screenshots.empty();
     int screenshotIndex = 0;
     int hintlessGuideShot = -1;  // the index of a guide's screenshot taken before its first hint was known
@@ -596,12 +619,95 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     // Benchmark figures.
     int guideFrames = 0, analyses = 0;
     double guideSeconds = 0.0;
-    std::vector<double> revealFrameSeconds, captureToReveal;
+    std::vector<double> revealFrameSeconds, captureToReveal, revealRenderSeconds, revealComposeSeconds,
+        revealPresentSeconds;
     // (Plain time points with a flag: gcc 12 takes optional<time_point> for maybe-uninitialised here.)
     std::chrono::steady_clock::time_point sideTakenAt{}, lastGuideFrame{};
     bool sideTaken = false, inGuide = false;
     std::optional<WatchdogPinger> watchdog;  // from READY on
     bool ready = false;
+
+    const auto discardQuietly = [&](const fs::path& folder) {
+        try {
+            if (!folder.empty()) store.discard(folder);
+        } catch (const BoothError& e) {
+            spdlog::error("discarding {}: {}", folder.string(), e.what());
+        }
+    };
+    // Leaves nothing of the current visitor's folder: removed now when written, else when its write ends.
+    const auto dropSessionFolder = [&] {
+        if (awaitingCharacter && awaitingCharacter->job == writeJob) awaitingCharacter.reset();  // never written
+        else if (written != Written::Writing) discardQuietly(pendingFolder);
+        pendingFolder.clear();
+        writeJob = 0;
+        written = Written::None;
+    };
+    const auto keepSession = [&](std::uint64_t job, const fs::path& folder, FlowTime now) {
+        try {
+            const std::string code = store.keep(folder, std::chrono::system_clock::now());
+            spdlog::info("session kept as {}", code);
+            report.keptCodes.push_back(code);
+            events.push_back(SessionSaved{code, now});
+            if (job == styleJob && styles->showsToon()) {
+                if (const auto kept = store.find(code)) toonStripFor = *kept;  // its toon strip follows
+            }
+        } catch (const BoothError& e) {
+            spdlog::error("session not kept: {}", e.what());
+            discardQuietly(folder);
+            events.push_back(SessionSaveFailed{e.what(), now});
+        }
+    };
+    // A finished background write: kept, held for the visitor's choice, or removed.
+    const auto handleWritten = [&](const SessionWriter::Done& done, FlowTime now) {
+        const auto keep = std::find(keepJobs.begin(), keepJobs.end(), done.job);
+        if (done.error) spdlog::error("the session folder was not written: {}", done.error->what());
+        else spdlog::info("session folder written in {:.2f} s", done.seconds);
+        if (keep != keepJobs.end()) {
+            keepJobs.erase(keep);
+            if (done.error) {
+                discardQuietly(done.folder);
+                events.push_back(SessionSaveFailed{done.error->what(), now});
+            } else {
+                keepSession(done.job, done.folder, now);
+            }
+        } else if (done.job == writeJob && written == Written::Writing) {
+            if (done.error) {
+                discardQuietly(done.folder);  // nothing partial stays
+                pendingFolder.clear();
+                written = Written::Failed;
+                writeFailure = done.error->what();
+            } else {
+                written = Written::Done;
+            }
+        } else {
+            discardQuietly(done.folder);  // the visitor retook a photo or left meanwhile
+        }
+    };
+
+    const auto addToonStrip = [&] {
+        try {
+            if (styles->writeToonStrip(toonStripFor))
+                spdlog::info("toon strip added to the kept session {}", toonStripFor.filename().string());
+        } catch (const BoothError& e) {
+            spdlog::error("the kept session {} goes without its toon strip: {}", toonStripFor.filename().string(),
+                          e.what());
+        }
+        toonStripFor.clear();
+    };
+
+    // The fit's character: shown among the styles, then the session folder (which holds it) is written.
+    const auto characterMade = [&](const CharacterResult& c) {
+        if (c.error) spdlog::warn("no character for this visitor: {}", *c.error);
+        if (c.job == styleJob) {
+            if (c.outputs) styles->visitorCharacter(c.outputs->head.mesh, c.outputs->head.texture);
+            else styles->visitorWithoutCharacter();
+        }
+        if (awaitingCharacter && awaitingCharacter->job == c.job) {
+            if (const FitPipeline* p = fitter.pipeline())
+                writer.submit(c.job, awaitingCharacter->outcome, p, awaitingCharacter->folder, c.outputs);
+            awaitingCharacter.reset();
+        }
+    };
 
     const auto execute = [&](const FlowCommand& command, FlowTime now) {
         spdlog::debug("command {}", describe(command));
@@ -625,6 +731,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                         spdlog::info("{} photo taken: {}x{}", c.photo == Photo::Front ? "front" : "side",
                                      still.image.cols, still.image.rows);
                         events.push_back(CaptureDone{c.photo, now});
+                        if (c.photo == Photo::Front && fitter.pipeline()) fitter.analyseFrontAhead(frontPhoto);
                         if (c.photo == Photo::Side) {
                             sideTakenAt = std::chrono::steady_clock::now();
                             sideTaken = true;
@@ -639,17 +746,22 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                     ++fitJob;  // its result will be dropped
                     fitWanted = false;
                 } else if constexpr (std::is_same_v<T, SaveSession>) {
-                    saveWanted = true;  // kept below, once the toon (drawn in the background) can go with it
-                } else if constexpr (std::is_same_v<T, DiscardSession>) {
-                    saveWanted = false;
-                    if (!pendingFolder.empty()) {
-                        try {
-                            store.discard(pendingFolder);
-                        } catch (const BoothError& e) {
-                            spdlog::error("discarding the session: {}", e.what());
-                        }
-                        pendingFolder.clear();
+                    if (written == Written::Done) {
+                        keepSession(writeJob, pendingFolder, now);
+                    } else if (written == Written::Writing) {
+                        // Kept as soon as it is written (the thanks screen shows the code then).
+                        spdlog::info("the session is kept once its folder is written");
+                        keepJobs.push_back(writeJob);
+                    } else {
+                        const std::string why = written == Written::Failed ? writeFailure : "no fitted avatar to keep";
+                        spdlog::error("session not kept: {}", why);
+                        events.push_back(SessionSaveFailed{why, now});
                     }
+                    pendingFolder.clear();
+                    writeJob = 0;
+                    written = Written::None;
+                } else if constexpr (std::is_same_v<T, DiscardSession>) {
+                    dropSessionFolder();
                     frontPhoto.release();
                     sidePhoto.release();
                     ++fitJob;
@@ -670,8 +782,12 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                         else if (name == "flash") lamps.setPattern(name, pattern(c.lamps.flash));
                     }
                 } else if constexpr (std::is_same_v<T, FreeDisk>) {
+                    // Leftovers are every pending folder: a session still being written must be finished first.
+                    writer.waitIdle();
+                    while (auto done = writer.take()) handleWritten(*done, now);
                     const RetentionReport r = store.applyRetention(std::chrono::system_clock::now());
                     const int leftovers = store.removeLeftovers();
+                    lastFreed = r;
                     spdlog::info("operator freed disk: {} photos, {} sessions, {} leftovers, {} bytes", r.photosDeleted,
                                  r.sessionsDeleted, leftovers, r.bytesFreed);
                 }
@@ -694,20 +810,27 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                 else events.push_back(ButtonReleased{*b, now});
             }
         }
-        if (options.visitor) {
-            const VisitorScript::Action a = options.visitor->step(flow.screen(), now);
-            simControls->setScene(a.scene);
-            if (a.press) {
-                events.push_back(ButtonPressed{*a.press, now});
-                releases.emplace_back(*a.press, now + kReleaseAfter);
-            }
-        }
+        // Simulated presses that are over (before any new press: a button is up before it goes down again).
         for (auto it = releases.begin(); it != releases.end();) {
             if (it->second <= now) {
                 events.push_back(ButtonReleased{it->first, now});
                 it = releases.erase(it);
             } else {
                 ++it;
+            }
+        }
+        if (options.visitor) {
+            const VisitorScript::Action a = options.visitor->step(flow.screen(), now);
+            simControls->setScene(a.scene);
+            if (a.cameraPlugged && *a.cameraPlugged != !simControls->vanished()) {
+                spdlog::info("simulated visitor: camera {}", *a.cameraPlugged ? "plugged back" : "unplugged");
+                if (*a.cameraPlugged) simControls->comeBack();
+                else simControls->vanish();
+            }
+            for (const auto& b : {a.press, a.pressWith}) {
+                if (!b) continue;
+                events.push_back(ButtonPressed{*b, now});
+                releases.emplace_back(*b, now + (a.holdFor > Millis(0) ? a.holdFor : kReleaseAfter));
             }
         }
 
@@ -752,65 +875,48 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
         if (auto analysed = previews.take()) {
             events.push_back(*analysed);
-            ++analyses;
+            // The figure is about the guides (the countdown analyses too, but its frames are not counted).
+            const ScreenId shown = flow.screen().id;
+            if (shown == ScreenId::FrontGuide || shown == ScreenId::SideGuide) ++analyses;
         }
 
         // The fit: started once the model is there and the analysis has let go of the detector.
         if (fitWanted && fitter.pipeline() && previews.release()) {
             (void)previews.take();
-            // A retake fits again: the earlier fit's folder (the visitor's photos) goes first.
-            if (!pendingFolder.empty()) {
-                try {
-                    store.discard(pendingFolder);
-                } catch (const BoothError& e) {
-                    spdlog::error("discarding the earlier fit: {}", e.what());
-                }
-            }
-            pendingFolder = store.pendingPath();
-            fitter.submit(++fitJob, frontPhoto, sidePhoto, pendingFolder);
-            spdlog::info("fitting into {}", pendingFolder.string());
+            dropSessionFolder();  // a retake: the earlier fit's folder goes
+            fitter.submit(++fitJob, frontPhoto, sidePhoto);
+            spdlog::info("fitting");
             fitWanted = false;
         }
         if (auto stageName = fitter.takeStage()) events.push_back(FitProgress{stageProgress(*stageName), *stageName, now});
         if (auto result = fitter.takeResult()) {
             if (result->job != fitJob) {
-                spdlog::info("a cancelled fit finished; its output is removed");
-                if (result->ok) store.discard(result->folder);
-            } else if (result->ok) {
-                stage.show(result->mesh, result->texture);
-                styles->visitor(std::move(result->styles));
+                spdlog::info("a cancelled fit finished; its result is dropped");
+            } else if (result->outcome) {
+                // The reveal starts now; the character is made next (by the fitter) and the folder written behind.
+                stage.show(result->outcome->fit.mesh, result->outcome->texture.texture);
+                if (!toonStripFor.empty() && !styles->toonSettled())
+                    spdlog::warn("the kept session {} goes without its toon strip: the next visitor came first",
+                                 toonStripFor.filename().string());
+                toonStripFor.clear();
+                styles->visitor(styleInputsFrom(*result->outcome));
+                styleJob = result->job;
                 events.push_back(FitDone{now});
+                pendingFolder = store.pendingPath();
+                writeJob = result->job;
+                written = Written::Writing;  // (the write itself starts once the character is made)
+                awaitingCharacter = WriteAfterCharacter{result->job, result->outcome, pendingFolder};
             } else {
                 spdlog::warn("fit failed: {}", result->error->what());
-                if (!pendingFolder.empty() && fs::exists(pendingFolder)) store.discard(pendingFolder);
-                pendingFolder.clear();
                 events.push_back(fitFailureFor(*result->error, now));
             }
         }
+        if (auto character = fitter.takeCharacter()) characterMade(*character);
+        while (auto done = writer.take()) handleWritten(*done, now);
 
-        // Keeping the session, with the toon's strip in it: the thanks screen says "saving" until then.
-        if (saveWanted && styles->toonSettled()) {
-            saveWanted = false;
-            try {
-                if (!pendingFolder.empty()) styles->writeToonStrip(pendingFolder);
-                const std::string code = store.keep(pendingFolder, std::chrono::system_clock::now());
-                spdlog::info("session kept as {}", code);
-                report.keptCodes.push_back(code);
-                pendingFolder.clear();
-                events.push_back(SessionSaved{code, now});
-            } catch (const BoothError& e) {
-                spdlog::error("session not kept: {}", e.what());
-                events.push_back(SessionSaveFailed{e.what(), now});
-                // Nothing of a session that could not be kept stays behind (the flow sends no discard after a
-                // keep, and the next fit would reuse pendingFolder).
-                try {
-                    if (!pendingFolder.empty()) store.discard(pendingFolder);
-                } catch (const BoothError& d) {
-                    spdlog::error("discarding the session that was not kept: {}", d.what());
-                }
-                pendingFolder.clear();
-            }
-        }
+        // A kept session's toon strip, once the toon is drawn (the keep does not wait for it: the thanks screen shows
+        // the code at once, and a toon slow to draw on a busy board must not hold the session back).
+        if (!toonStripFor.empty() && styles->toonSettled()) addToonStrip();
 
         // The flow: every event, then a tick for the timeouts and the countdown.
         events.push_back(Tick{now});
@@ -840,10 +946,21 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         const bool previewScreen = screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide ||
                                    screen.id == ScreenId::Countdown;
         if (previewScreen) inputs.preview = lastPreview;
+        const std::uint64_t rendersBefore = stage.renders(), stylesBefore = styles->version();
         if (screen.id == ScreenId::Reveal || screen.id == ScreenId::Attract) {
-            inputs.avatar = stage.frame(screen.id == ScreenId::Reveal, screen.sinceEntered);
+            // Rendered at the size it is shown (no rescaling), and only when the pose changes.
+            const cv::Rect box = screens.avatarImageBoxes(screen.id, styleCount)[0];
+            inputs.avatar = stage.frame(screen.id == ScreenId::Reveal, screen.sinceEntered, std::min(box.width, box.height));
             styles->fill(inputs, screen.id == ScreenId::Reveal, screen.sinceEntered, screens.layout());
+            // One version for every image shown: the screen is not composed again while none has changed.
+            if (stage.version() != shownVersions.first || styles->version() != shownVersions.second) {
+                shownVersions = {stage.version(), styles->version()};
+                ++avatarsVersion;
+            }
+            inputs.avatarVersion = stage.version() == 0 ? 0 : avatarsVersion;
         }
+        const bool rendered = stage.renders() != rendersBefore || styles->version() != stylesBefore;
+        const auto renderEnd = std::chrono::steady_clock::now();
         if (screen.id == ScreenId::RetakeChoice) {
             inputs.frontPhoto = frontPhoto;
             inputs.sidePhoto = sidePhoto;
@@ -855,8 +972,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             }
             inputs.operatorInfo.sessionsStored = static_cast<int>(store.list().size());
             inputs.operatorInfo.freeBytes = store.freeBytes();
+            inputs.operatorInfo.lastFreed = lastFreed;
         }
         const cv::Mat& drawn = screens.draw(screen, inputs);
+        const auto composeEnd = std::chrono::steady_clock::now();
         display.present(drawn);
         const auto drawEnd = std::chrono::steady_clock::now();
         if (screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide) {
@@ -871,12 +990,17 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
         if (screen.id == ScreenId::Reveal && !inputs.avatar.empty()) {
             revealFrameSeconds.push_back(Seconds(drawEnd - drawStart).count());
+            if (rendered) revealRenderSeconds.push_back(Seconds(renderEnd - drawStart).count());
+            revealComposeSeconds.push_back(Seconds(composeEnd - renderEnd).count());
+            revealPresentSeconds.push_back(Seconds(drawEnd - composeEnd).count());
             if (sideTaken) {
                 captureToReveal.push_back(Seconds(drawEnd - sideTakenAt).count());
                 sideTaken = false;
             }
         }
-        if (screen.id != lastScreen) {
+        // A new screen, or another page of the operator menu, gets its own screenshot.
+        if (screen.id != lastScreen || (screen.id == ScreenId::OperatorMenu && screen.menuPage != lastMenuPage)) {
+            lastMenuPage = screen.menuPage;
             screenshotDue = !options.screenshots.empty();
             hintlessGuideShot = -1;
         }
@@ -888,18 +1012,20 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             spdlog::info("{}: hint {}", toString(screen.id), toString(screen.hint));
         lastHint = screen.hint;
         if (hintlessGuideShot >= 0 && screen.hint != Hint::None) {
-            writeScreenshot(options.screenshots, hintlessGuideShot, screen.id, drawn, report, true);
+            writeScreenshot(options.screenshots, hintlessGuideShot, screen, drawn, report, true);
             hintlessGuideShot = -1;
         }
         const bool complete = (!previewScreen || (!inputs.preview.empty() && screen.sinceEntered >= Millis(700))) &&
-                              // (every style drawn; a toon still drawing after 2.5 s is pictured as it is)
+                              // (every style drawn: the character always comes, made right after the fit; a toon
+                              // still drawing after 2.5 s is pictured as it is)
                               (screen.id != ScreenId::Reveal ||
-                               (!inputs.avatar.empty() && (styles->complete() || screen.sinceEntered >= Millis(2500)))) &&
+                               (!inputs.avatar.empty() && !styles->characterPending() &&
+                                (styles->complete() || screen.sinceEntered >= Millis(2500)))) &&
                               (screen.id != ScreenId::Thanks || !screen.code.empty());
         lastScreen = screen.id;
         if (screenshotDue && complete) {
             if (guide && screen.hint == Hint::None) hintlessGuideShot = screenshotIndex;
-            writeScreenshot(options.screenshots, screenshotIndex++, screen.id, drawn, report);
+            writeScreenshot(options.screenshots, screenshotIndex++, screen, drawn, report);
             screenshotDue = false;
         }
         if (!ready) {
@@ -939,11 +1065,39 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     report.characterRenders = figures.characterRenders;
     report.toonRenders = figures.toonRenders;
     report.stageRenders = figures.stageRenders;
+    report.revealSlowestFrameMilliseconds =
+        revealFrameSeconds.empty() ? 0.0 : 1000.0 * *std::max_element(revealFrameSeconds.begin(), revealFrameSeconds.end());
+    report.revealRenderMilliseconds = 1000.0 * median(revealRenderSeconds);
+    report.revealComposeMilliseconds = 1000.0 * median(revealComposeSeconds);
+    report.revealPresentMilliseconds = 1000.0 * median(revealPresentSeconds);
+    report.revealRenderedShare = revealFrameSeconds.empty() ? 0.0
+        : static_cast<double>(revealRenderSeconds.size()) / static_cast<double>(revealFrameSeconds.size());
+    report.avatarTriangles = stage.triangleCount();
+    report.avatarSamples = stage.samples();
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     report.peakRssMegabytes = static_cast<double>(usage.ru_maxrss) / 1024.0;
-    // Leave nothing of a visitor who was still in the middle of a session.
-    if (!pendingFolder.empty()) store.discard(pendingFolder);
+    // Sessions being written: those kept are kept; nothing of a visitor still in the middle of a session stays.
+    if (awaitingCharacter && std::find(keepJobs.begin(), keepJobs.end(), awaitingCharacter->job) != keepJobs.end()) {
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        while (awaitingCharacter && std::chrono::steady_clock::now() < deadline) {
+            if (auto character = fitter.takeCharacter()) characterMade(*character);
+            else std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+    }
+    writer.waitIdle();
+    while (auto done = writer.take()) handleWritten(*done, FlowClock::now());
+    dropSessionFolder();
+    // The last kept session's toon strip: a run of N sessions waits for it (bounded); a stop or a closed window
+    // does not (systemd's stop timeout), and the session stays complete without it.
+    const bool stopped = (options.stop && options.stop->load()) || display.closeRequested();
+    const auto toonDeadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!toonStripFor.empty() && !stopped && !styles->toonSettled() && std::chrono::steady_clock::now() < toonDeadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (!toonStripFor.empty() && styles->toonSettled()) addToonStrip();
+    if (!toonStripFor.empty())
+        spdlog::warn("the kept session {} goes without its toon strip: still drawing at the end",
+                     toonStripFor.filename().string());
     return report;
 }
 

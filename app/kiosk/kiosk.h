@@ -25,7 +25,10 @@ class VisitorScript {
 public:
     struct Action {
         SimScene scene = SimScene::Empty;
-        std::optional<Button> press;  // pressed now and released a moment later
+        std::optional<Button> press;      // pressed now and released a moment later (or after holdFor)
+        std::optional<Button> pressWith;  // a second button pressed with it (the operator's lock combination)
+        Millis holdFor{0};                // how long the press lasts (0: a short press)
+        std::optional<bool> cameraPlugged;  // unplug (false) or plug back (true) the simulated camera
     };
     virtual ~VisitorScript() = default;
     virtual Action step(const ScreenModel& screen, FlowTime now) = 0;
@@ -53,6 +56,15 @@ struct KioskReport {
     double analysesPerSecond = 0.0;               // preview analyses (face guidance) per second during the guides
     double sideCaptureToRevealSeconds = 0.0;      // the side photo taken -> the avatar on the reveal screen
     double revealFrameMilliseconds = 0.0;         // one reveal frame: avatar render + screen + present
+    double revealSlowestFrameMilliseconds = 0.0;  // the slowest reveal frame
+    // Its parts: the avatar's render (median over the frames that rendered one; a held pose renders nothing), the
+    // screen's composition, the present; and the share of reveal frames that rendered.
+    double revealRenderMilliseconds = 0.0;
+    double revealComposeMilliseconds = 0.0;
+    double revealPresentMilliseconds = 0.0;
+    double revealRenderedShare = 0.0;
+    std::size_t avatarTriangles = 0;              // of the avatar shown last
+    int avatarSamples = 0;                        // the avatar render's samples per pixel
     double peakRssMegabytes = 0.0;                // of the whole process (getrusage)
     // The reveal's other styles (medians over the frames that drew them; held frames reuse the last image).
     double characterFrameMilliseconds = 0.0;      // one character render

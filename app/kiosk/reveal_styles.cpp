@@ -161,7 +161,7 @@ private:
 
 }  // namespace
 
-StyleInputs styleInputsFrom(const FitOutcome& o, CharacterHead&& character) {
+StyleInputs styleInputsFrom(const FitOutcome& o) {
     StyleInputs in;
     in.front = o.front;
     in.frontMask = o.frontMask;
@@ -170,8 +170,6 @@ StyleInputs styleInputsFrom(const FitOutcome& o, CharacterHead&& character) {
     in.sideNoseImageRight = o.sideNoseImageRight;
     if (const auto it = o.sideLandmarks.find("chin"); it != o.sideLandmarks.end())
         in.sideChinRow = static_cast<int>(it->second.y) + 1;
-    in.characterMesh = std::move(character.mesh);
-    in.characterTexture = std::move(character.texture);
     return in;
 }
 
@@ -185,6 +183,7 @@ struct RevealStyles::Impl {
     // Character: its own renderer (one upload per visitor), the last image and the pose it was drawn at.
     std::unique_ptr<MeshRenderer> characterRenderer;
     bool characterLoaded = false;
+    bool characterAwaited = false;  // the visitor's character is being made (its place says so on the reveal)
     glm::dvec3 centre{0.0};
     double extent = 1.0;
     cv::Mat characterImage;
@@ -205,6 +204,8 @@ struct RevealStyles::Impl {
 
     std::vector<double> characterMs, toonMs, stageMs;
     StyleFigures figures;
+    std::uint64_t version = 1;
+    std::vector<std::pair<std::string, bool>> lastListed;  // the styles the last fill() listed, with an image or not
 
     void showCharacter(const Mesh& mesh, const cv::Mat& texture) {
         characterRenderer->upload(mesh, texture);
@@ -213,7 +214,9 @@ struct RevealStyles::Impl {
         centre = (lo + hi) * 0.5;
         extent = glm::length(hi - lo);
         characterLoaded = true;
+        characterAwaited = false;
         characterPose.reset();
+        ++version;
     }
 
     // The same view of the head as the kiosk's photo avatar (AvatarStage), so the two turn together.
@@ -231,6 +234,7 @@ struct RevealStyles::Impl {
         characterPose = model;
         remember(characterMs, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
         ++figures.characterRenders;
+        ++version;
         return characterImage;
     }
 
@@ -244,6 +248,7 @@ struct RevealStyles::Impl {
         toonImageYaw = yaw;
         remember(toonMs, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
         ++figures.toonRenders;
+        ++version;
         return toonImage;
     }
 
@@ -296,8 +301,10 @@ RevealStyles::~RevealStyles() = default;
 
 void RevealStyles::visitor(StyleInputs inputs) {
     Impl& s = *impl_;
-    if (s.characterRenderer && !inputs.characterMesh.positions.empty())
-        s.showCharacter(inputs.characterMesh, inputs.characterTexture);
+    if (s.characterRenderer) {
+        s.characterLoaded = false;
+        s.characterAwaited = true;
+    }
     if (s.toonWorker) {
         s.toonModel.reset();  // never the previous visitor's toon on this one's reveal
         s.toonStrip.clear();
@@ -306,6 +313,20 @@ void RevealStyles::visitor(StyleInputs inputs) {
         s.toonPending = s.toonDrawing = true;
     }
 }
+
+void RevealStyles::visitorCharacter(const Mesh& mesh, const cv::Mat& texture) {
+    if (impl_->characterRenderer && !mesh.positions.empty()) impl_->showCharacter(mesh, texture);
+}
+
+void RevealStyles::visitorWithoutCharacter() {
+    Impl& s = *impl_;
+    if (!s.characterAwaited) return;
+    s.characterAwaited = false;
+    s.characterLoaded = false;
+    ++s.version;
+}
+
+std::uint64_t RevealStyles::version() const { return impl_->version; }
 
 void RevealStyles::fill(ScreenInputs& in, bool reveal, std::chrono::milliseconds since, const ScreenLayout& layout) {
     Impl& s = *impl_;
@@ -325,8 +346,12 @@ void RevealStyles::fill(ScreenInputs& in, bool reveal, std::chrono::milliseconds
                 if (in.avatar.empty()) complete_ = false;
                 break;
             case AvatarStyle::Character:
-                if (!s.characterLoaded || !frame) break;
-                in.avatars.push_back({toString(style), s.renderCharacter(frame->headModel)});
+                if (s.characterLoaded && frame) {
+                    in.avatars.push_back({toString(style), s.renderCharacter(frame->headModel)});
+                } else if (reveal && s.characterAwaited) {
+                    in.avatars.push_back({toString(style), cv::Mat()});  // its place, with "making" in it
+                    complete_ = false;
+                }
                 break;
             case AvatarStyle::Toon:
                 if (s.toonModel && frame) {
@@ -354,10 +379,21 @@ void RevealStyles::fill(ScreenInputs& in, bool reveal, std::chrono::milliseconds
         if (s.stage->renders() != before) {
             remember(s.stageMs, s.stage->lastRenderMilliseconds());
             ++s.figures.stageRenders;
+            ++s.version;
         }
+    }
+    std::vector<std::pair<std::string, bool>> listed;
+    for (const StyledAvatar& a : in.avatars) listed.emplace_back(a.style, !a.image.empty());
+    if (listed != s.lastListed) {
+        s.lastListed = std::move(listed);
+        ++s.version;
     }
     ++s.figures.frames;
 }
+
+bool RevealStyles::characterPending() const { return impl_->characterAwaited; }
+
+bool RevealStyles::showsToon() const { return impl_->toonWorker != nullptr; }
 
 bool RevealStyles::toonSettled() const {
     impl_->collectToon();

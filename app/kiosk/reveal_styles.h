@@ -1,10 +1,11 @@
 // The avatar styles besides the photo-fitted head on the reveal and attract screens — the character (issue 6) and
 // the two-view toon (issue 7) — and the tile stage under them, as the kiosk's main loop uses them.
 //
-// The kiosk hands each finished fit to visitor(); the character head comes with it (made once, by the pipeline's
-// write), the toon is drawn from the two photos on a worker thread of its own so the screen never waits. Each
-// frame, fill() adds the styles' images (and the stage) to the screen's inputs; every image is kept and reused while
-// the animation holds a pose or the stage camera holds its angle.
+// The kiosk hands each finished fit to visitor(), and the character head to visitorCharacter() when the fitter has
+// made it (a moment later: the reveal does not wait for it); the toon is drawn from the two photos on a
+// worker thread of its own so the screen never waits. Each frame, fill() adds the styles' images (and the stage) to
+// the screen's inputs; every image is kept and reused while the animation holds a pose or the stage camera holds
+// its angle.
 #pragma once
 
 #include "animation/avatar_motion.h"
@@ -24,18 +25,15 @@
 namespace avatarbooth {
 
 struct FitOutcome;
-struct CharacterHead;
 
-// What the styles need of one fit: the photos with their head masks (toon), the character head (character).
+// What the toon needs of one fit: the photos with their head masks.
 struct StyleInputs {
     cv::Mat front, frontMask, side, sideMask;
     bool sideNoseImageRight = true;
     int sideChinRow = -1;  // the side photo's chin row: both masks are cut there (head only); -1: not cut
-    Mesh characterMesh;    // empty when the character is off
-    cv::Mat characterTexture;
 };
-// Takes what the styles need from a fit (the photos and masks are shared, not copied) and the character head.
-StyleInputs styleInputsFrom(const FitOutcome& outcome, CharacterHead&& character);
+// Takes what the styles need from a fit (the photos and masks are shared, not copied).
+StyleInputs styleInputsFrom(const FitOutcome& outcome);
 
 // Per-style cost of the last frames, for the benchmark figures (milliseconds, medians over the frames that drew).
 struct StyleFigures {
@@ -52,14 +50,25 @@ public:
                  const BaseHead& base, int avatarSize);
     ~RevealStyles();
 
-    // A new visitor's fit: shows their character at once and starts drawing their toon (an earlier toon still being
-    // drawn is dropped).
+    // A new visitor's fit: starts drawing their toon (an earlier toon still being drawn is dropped); their character
+    // is awaited (its place says so on the reveal; never the previous visitor's).
     void visitor(StyleInputs inputs);
+    // The current visitor's character head, once made; or none (its making or the session's write failed): the
+    // character's place is then left out.
+    void visitorCharacter(const Mesh& mesh, const cv::Mat& texture);
+    void visitorWithoutCharacter();
+    // Changes whenever an image fill() hands out changes (a new render, a style appearing or going); for the screen,
+    // which does not compose an unchanged reveal again.
+    std::uint64_t version() const;
 
     // Adds to `in` the image of every configured style in order (the photo style is `in.avatar`, which the kiosk
     // rendered) and the stage, for the reveal (`reveal`) or attract screen `since` it was entered.
     void fill(ScreenInputs& in, bool reveal, std::chrono::milliseconds since, const ScreenLayout& layout);
 
+    // The visitor's character is still being made (it comes, or visitorWithoutCharacter() says it will not).
+    bool characterPending() const;
+    // Whether the toon style is on (drawn for every visitor).
+    bool showsToon() const;
     // Whether the last fill() had an image for every style it listed (the toon may still be drawing).
     bool complete() const { return complete_; }
     // No toon is being drawn for the current visitor (drawn, failed, or none asked for).

@@ -34,8 +34,8 @@ double processCpuSeconds() {
 }
 
 // Runs one stage, timing it, and names the photo in any error that does not name a file yet.
-template <typename F>
-auto stage(FitOutcome& out, const StageListener& listener, const char* name, const fs::path& photo, F&& work) {
+template <typename Out, typename F>
+auto stage(Out& out, const StageListener& listener, const char* name, const fs::path& photo, F&& work) {
     if (listener) listener(name);
     const auto t0 = Clock::now();
     const double cpu0 = processCpuSeconds();
@@ -109,8 +109,19 @@ FitOutcome FitPipeline::fit(const FitInputs& inputs) const {
     return out;
 }
 
+FrontAnalysis FitPipeline::analyseFront(const cv::Mat& front, const cv::Mat& background, const FitInputs& names,
+                                        const StageListener& listener) const {
+    FrontAnalysis a;
+    a.photo = front;
+    a.background = background;
+    a.landmarks = stage(a, listener, "front_landmarks", names.front, [&] { return detector_->detect(front); });
+    a.mask = stage(a, listener, "front_silhouette", names.front,
+                   [&] { return segmentPerson(front, background, a.landmarks.face); });
+    return a;
+}
+
 FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv::Mat& background,
-                            const FitInputs& names, const StageListener& listener) const {
+                            const FitInputs& names, const StageListener& listener, const FrontAnalysis* ahead) const {
     FitOutcome out;
     out.front = front;
     out.side = side;
@@ -118,12 +129,20 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     if (!background.empty() && background.size() != side.size())
         throw BoothError(ErrorKind::BadInput, names.side.string(), "the side photo and the background plate differ in size");
 
-    out.frontLandmarks = stage(out, listener, "front_landmarks", names.front, [&] { return detector_->detect(front); });
+    // The front's analysis made ahead counts only for these very pixels (a retaken front photo is analysed anew).
+    const bool useAhead = ahead != nullptr && ahead->photo.data == front.data && ahead->photo.size() == front.size() &&
+                          ahead->background.data == background.data;
+    const FrontAnalysis frontAnalysis = useAhead ? *ahead : analyseFront(front, background, names, listener);
+    out.frontLandmarks = frontAnalysis.landmarks;
+    out.frontMask = frontAnalysis.mask;
+    out.stageSeconds = frontAnalysis.stageSeconds;
+    out.stageCpuSeconds = frontAnalysis.stageCpuSeconds;
+    if (useAhead)
+        for (auto* list : {&out.stageSeconds, &out.stageCpuSeconds})
+            for (auto& [name, seconds] : *list) name += "_ahead";  // not on this fit's clock
     if (out.frontLandmarks.facesFound > 1)
         out.warnings.push_back(std::to_string(out.frontLandmarks.facesFound) +
                                " faces in the front photo; the largest was used");
-    out.frontMask = stage(out, listener, "front_silhouette", names.front,
-                          [&] { return segmentPerson(front, background, out.frontLandmarks.face); });
     const SideAnalysis sideAnalysis = stage(out, listener, "side_profile", names.side, [&] { return analyzeSidePhoto(side, background); });
     out.sideMask = sideAnalysis.mask;
     out.sideNoseImageRight = sideAnalysis.noseImageRight;
@@ -180,7 +199,7 @@ cv::Mat drawSideOverlayWithRays(const FitOutcome& o) {
 }
 
 std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& inputs, const fs::path& outDir,
-                                         MeshRenderer& renderer, CharacterHead* characterOut) const {
+                                         MeshRenderer& renderer, const CharacterOutputs* madeCharacter) const {
     StagedDirectory dir(outDir, "fit.json");
     const fs::path s = dir.staging();
     std::vector<fs::path> written;
@@ -228,10 +247,10 @@ std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& i
 
     // Character maker (issue 6, app/character/): Narita's proportions and the stylised character head.
     const auto tCharacter = Clock::now();
-    CharacterOutputs character;
+    CharacterOutputs madeHere;
+    if (settings_.characterEnabled && !madeCharacter) madeHere = makeCharacter(o);
+    const CharacterOutputs& character = madeCharacter ? *madeCharacter : madeHere;
     if (settings_.characterEnabled) {
-        character = makeCharacterOutputs(o.front, o.frontLandmarks.points, o.frontMask,
-                                         earHoleInFrontPhoto(o.fit, o.sideLandmarks), base_, settings_.character);
         put("character.json", character.json);
         put("character.glb", character.glb);
     }
@@ -274,8 +293,13 @@ std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& i
     // fit.json last: its presence marks a complete result.
     put("fit.json", report.dump(2) + "\n");
     dir.commit();
-    if (characterOut && settings_.characterEnabled) *characterOut = std::move(character.head);
     return written;
+}
+
+CharacterOutputs FitPipeline::makeCharacter(const FitOutcome& o) const {
+    if (!settings_.characterEnabled) return {};
+    return makeCharacterOutputs(o.front, o.frontLandmarks.points, o.frontMask,
+                                earHoleInFrontPhoto(o.fit, o.sideLandmarks), base_, settings_.character);
 }
 
 }  // namespace avatarbooth

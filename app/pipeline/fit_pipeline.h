@@ -2,7 +2,7 @@
 // read photos -> front landmarks + silhouette -> side profile -> fit -> texture -> previews -> session folder.
 #pragma once
 
-#include "character/character_head.h"
+#include "character/character_outputs.h"
 #include "face/landmarks68.h"
 #include "head/base_head.h"
 #include "head/head_fit.h"
@@ -52,6 +52,16 @@ struct FitOutcome {
     std::vector<std::string> warnings;
 };
 
+// The front photo's analysis (landmarks, silhouette): fit()'s first two stages, which a booth runs as soon as the
+// front photo is taken, while the visitor turns for the side photo.
+struct FrontAnalysis {
+    cv::Mat photo;  // the very image analysed: fit() uses the analysis only for a front photo sharing its pixels
+    cv::Mat background;
+    FaceLandmarks landmarks;
+    cv::Mat mask;
+    std::vector<std::pair<std::string, double>> stageSeconds, stageCpuSeconds;
+};
+
 // Told the name of each stage as it starts ("front_landmarks", "front_silhouette", "side_profile", "head_fit",
 // "texture"), from the fitting thread: the kiosk shows progress with it.
 using StageListener = std::function<void(const std::string& stage)>;
@@ -74,15 +84,25 @@ public:
     // Reads, analyses, fits and textures. Errors are BoothErrors naming the photo they concern.
     FitOutcome fit(const FitInputs& inputs) const;
     // The same on photos already in memory (names are used in error messages).
+    // `ahead`: the front photo's analysis made earlier (analyseFront), used when it is of this front photo and
+    // background (else the front is analysed here).
     FitOutcome fit(const cv::Mat& front, const cv::Mat& side, const cv::Mat& background,
-                   const FitInputs& names = {}, const StageListener& listener = {}) const;
+                   const FitInputs& names = {}, const StageListener& listener = {},
+                   const FrontAnalysis* ahead = nullptr) const;
+    // The front photo's landmarks and silhouette alone (BoothError NoFace naming the photo when there is no face).
+    FrontAnalysis analyseFront(const cv::Mat& front, const cv::Mat& background, const FitInputs& names = {},
+                               const StageListener& listener = {}) const;
 
     // Writes the session folder atomically: it is complete, or absent (an earlier result stays as it was).
-    // Returns the paths of what was written. The renderer makes the previews. The character head made for
-    // character.glb is handed to `character` when given (the kiosk shows it: made once per fit).
+    // Returns the paths of what was written. The renderer makes the previews. `character`: the character outputs
+    // made beforehand with makeCharacter (the kiosk shows the head before the folder is written); made here when
+    // null.
     std::vector<std::filesystem::path> write(const FitOutcome& outcome, const FitInputs& inputs,
                                              const std::filesystem::path& out, MeshRenderer& renderer,
-                                             CharacterHead* character = nullptr) const;
+                                             const CharacterOutputs* character = nullptr) const;
+    // The character maker's outputs for a fit (character.json, character.glb and the head itself); empty when the
+    // character is off ([character] enabled = false).
+    CharacterOutputs makeCharacter(const FitOutcome& outcome) const;
 
 private:
     FitPipeline(const FitPipeline& shareFrom, std::unique_ptr<LandmarkDetector> detector);

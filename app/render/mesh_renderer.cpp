@@ -259,7 +259,9 @@ double RenderCamera::depthOf(glm::dvec3 point) const { return -(view * glm::dvec
 
 // ---- MeshRenderer ----------------------------------------------------------------------------------------------
 
-MeshRenderer::MeshRenderer() {
+MeshRenderer::MeshRenderer() : MeshRenderer(Options{}) {}
+
+MeshRenderer::MeshRenderer(Options options) : options_(options) {
     try {
         ownedContext_ = std::make_unique<HeadlessEglContext>();
     } catch (const BoothError&) {
@@ -271,7 +273,9 @@ MeshRenderer::MeshRenderer() {
     createPipeline();
 }
 
-MeshRenderer::MeshRenderer(HeadlessEglContext& context) : context_(&context) { createPipeline(); }
+MeshRenderer::MeshRenderer(HeadlessEglContext& context, Options options) : options_(options), context_(&context) {
+    createPipeline();
+}
 
 MeshRenderer::~MeshRenderer() {
     try {
@@ -352,7 +356,8 @@ void MeshRenderer::createPipeline() {
         glGetIntegerv(GL_MAX_VIEWPORT_DIMS, maxViewport);
         gl_->maxRenderSize = std::min({gl_->maxRenderSize, maxViewport[0], maxViewport[1]});
         glGetIntegerv(GL_MAX_TEXTURE_SIZE, &gl_->maxTextureSize);
-        samples_ = std::min({maxSamples(GL_RGBA8), maxSamples(GL_RG32F), maxSamples(GL_DEPTH_COMPONENT24)});
+        samples_ = std::min({maxSamples(GL_RGBA8), maxSamples(GL_DEPTH_COMPONENT24), std::max(1, options_.maxSamples)});
+        if (options_.depth) samples_ = std::min(samples_, maxSamples(GL_RG32F));
         checkGl("creating the shader program and vertex arrays");
     } catch (...) {
         releaseAll();
@@ -402,7 +407,7 @@ void MeshRenderer::ensureTargets(int width, int height) {
             glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, rb);
         };
         attach(colour, GL_RGBA8, GL_COLOR_ATTACHMENT0);
-        attach(depthCoverage, GL_RG32F, GL_COLOR_ATTACHMENT1);
+        if (options_.depth) attach(depthCoverage, GL_RG32F, GL_COLOR_ATTACHMENT1);
         if (withDepth) attach(depth, GL_DEPTH_COMPONENT24, GL_DEPTH_ATTACHMENT);
         const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
         if (status != GL_FRAMEBUFFER_COMPLETE)
@@ -459,7 +464,9 @@ void MeshRenderer::upload(const Mesh& mesh, const cv::Mat& textureBgr) {
     if (mesh.triangles.size() > static_cast<std::size_t>(std::numeric_limits<GLsizei>::max() / 3))
         fail("the mesh has too many triangles");
     makeCurrent();
-    const cv::Mat rgba = toRgba(textureBgr, gl_->maxTextureSize);
+    const int textureLimit =
+        options_.maxTextureSize > 0 ? std::min(options_.maxTextureSize, gl_->maxTextureSize) : gl_->maxTextureSize;
+    const cv::Mat rgba = toRgba(textureBgr, textureLimit);
 
     glm::dvec3 lo(0.0), hi(0.0);
     if (n > 0) mesh.bounds(lo, hi);
@@ -508,7 +515,7 @@ void MeshRenderer::upload(const Mesh& mesh, const cv::Mat& textureBgr) {
     triangleCount_ = mesh.triangles.size();
 }
 
-RenderResult MeshRenderer::render(const RenderCamera& camera) {
+void MeshRenderer::drawScene(const RenderCamera& camera, bool withDepth) {
     const int width = camera.width, height = camera.height;
     if (width <= 0 || height <= 0 || width > gl_->maxRenderSize || height > gl_->maxRenderSize)
         fail("cannot render " + std::to_string(width) + "x" + std::to_string(height) + " (limit " +
@@ -519,8 +526,11 @@ RenderResult MeshRenderer::render(const RenderCamera& camera) {
     // All the state we rely on, set every time (a borrowed context may have been used by others).
     const GLuint drawFbo = samples_ > 1 ? gl_->msaaFbo : gl_->resolveFbo;
     glBindFramebuffer(GL_FRAMEBUFFER, drawFbo);
-    const GLenum both[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, both);
+    // The depth + coverage target exists only for renderers made with depth; a render that does not want it
+    // (renderBgra) does not write it.
+    const GLenum both[] = {GL_COLOR_ATTACHMENT0, withDepth ? static_cast<GLenum>(GL_COLOR_ATTACHMENT1) : static_cast<GLenum>(GL_NONE)};
+    const GLsizei targets = options_.depth ? 2 : 1;
+    glDrawBuffers(targets, both);
     glViewport(0, 0, width, height);
     glDisable(GL_SCISSOR_TEST);
     glDisable(GL_BLEND);
@@ -539,7 +549,7 @@ RenderResult MeshRenderer::render(const RenderCamera& camera) {
     const GLfloat nothing[] = {0.0f, 0.0f, 0.0f, 0.0f};
     const GLfloat far = 1.0f;
     glClearBufferfv(GL_COLOR, 0, background);
-    glClearBufferfv(GL_COLOR, 1, nothing);
+    if (withDepth) glClearBufferfv(GL_COLOR, 1, nothing);
     glClearBufferfv(GL_DEPTH, 0, &far);
 
     if (gl_->indexCount > 0) {
@@ -570,15 +580,20 @@ RenderResult MeshRenderer::render(const RenderCamera& camera) {
     if (samples_ > 1) {  // resolve each attachment into its single-sample twin
         glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->msaaFbo);
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, gl_->resolveFbo);
-        for (int i = 0; i < 2; ++i) {
+        for (int i = 0; i < (withDepth ? 2 : 1); ++i) {
             const GLenum attachment = GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(i);
             const GLenum draw[] = {i == 0 ? attachment : GL_NONE, i == 1 ? attachment : GL_NONE};
             glReadBuffer(attachment);
-            glDrawBuffers(2, draw);
+            glDrawBuffers(targets, draw);
             glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
         }
-        glDrawBuffers(2, both);
+        glDrawBuffers(targets, both);
     }
+}
+
+RenderResult MeshRenderer::render(const RenderCamera& camera) {
+    const int width = camera.width, height = camera.height;
+    drawScene(camera, options_.depth);
 
     // Read back (GL rows start at the bottom) and turn into top-row-first images.
     glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolveFbo);
@@ -587,11 +602,14 @@ RenderResult MeshRenderer::render(const RenderCamera& camera) {
     glPixelStorei(GL_PACK_ROW_LENGTH, 0);
     glPixelStorei(GL_PACK_SKIP_ROWS, 0);
     glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
-    cv::Mat rgba(height, width, CV_8UC4), depthCoverage(height, width, CV_32FC4);
+    cv::Mat rgba(height, width, CV_8UC4), depthCoverage;
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
-    glReadBuffer(GL_COLOR_ATTACHMENT1);
-    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, depthCoverage.data);
+    if (options_.depth) {
+        depthCoverage.create(height, width, CV_32FC4);
+        glReadBuffer(GL_COLOR_ATTACHMENT1);
+        glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, depthCoverage.data);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     checkGl("rendering and reading back the offscreen image");
 
@@ -599,6 +617,7 @@ RenderResult MeshRenderer::render(const RenderCamera& camera) {
     cv::flip(rgba, rgba, 0);
     cv::cvtColor(rgba, result.bgr, cv::COLOR_RGBA2BGR);
     cv::extractChannel(rgba, result.mask, 3);
+    if (!options_.depth) return result;
     result.depth.create(height, width, CV_32F);
     for (int r = 0; r < height; ++r) {
         const auto* in = depthCoverage.ptr<cv::Vec4f>(height - 1 - r);
@@ -606,6 +625,26 @@ RenderResult MeshRenderer::render(const RenderCamera& camera) {
         for (int c = 0; c < width; ++c) out[c] = in[c][1] > 1e-6f ? in[c][0] / in[c][1] : 0.0f;
     }
     return result;
+}
+
+void MeshRenderer::renderBgra(const RenderCamera& camera, cv::Mat& bgra) {
+    const int width = camera.width, height = camera.height;
+    drawScene(camera, false);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolveFbo);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+    glPixelStorei(GL_PACK_SKIP_ROWS, 0);
+    glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
+    readBuffer_.create(height, width, CV_8UC4);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, readBuffer_.data);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    checkGl("rendering and reading back the offscreen image");
+    // GL rows start at the bottom; alpha (cleared to 0, written 1) resolves to the covered fraction.
+    bgra.create(height, width, CV_8UC4);
+    cv::flip(readBuffer_, bgra, 0);
+    cv::cvtColor(bgra, bgra, cv::COLOR_RGBA2BGRA);
 }
 
 }  // namespace avatarbooth

@@ -51,6 +51,14 @@ struct RenderResult {
                     // 0 where nothing
 };
 
+// What a MeshRenderer is for. The defaults suit measurement and export renders; the kiosk's avatar stage, which
+// renders every frame under llvmpipe, asks for fewer samples, no depth and a smaller texture.
+struct MeshRendererOptions {
+    int maxSamples = 4;      // samples per pixel at most (1: no multisampling)
+    bool depth = true;       // false: render() leaves RenderResult::depth empty (no depth target, no read-back)
+    int maxTextureSize = 0;  // textures larger than this are scaled down on upload (0: the GL limit)
+};
+
 // Holds one mesh and its texture on the GPU and renders them into offscreen images, as often as asked.
 //
 // Lit renders use smooth normals welded by position (a UV seam that duplicates vertices does not show), a key light
@@ -65,10 +73,13 @@ public:
     static constexpr glm::dvec3 kFillLightEye{-0.70, -0.05, 0.71};
     static constexpr double kAmbient = 0.30, kKey = 0.65, kFill = 0.20;
 
+    using Options = MeshRendererOptions;
+
     // Creates its own headless GL context (this costs time: create one renderer and render many views).
     MeshRenderer();
+    explicit MeshRenderer(Options options);
     // Renders through a context the caller owns; it must outlive the renderer.
-    explicit MeshRenderer(HeadlessEglContext& context);
+    explicit MeshRenderer(HeadlessEglContext& context, Options options = {});
     ~MeshRenderer();
 
     MeshRenderer(const MeshRenderer&) = delete;
@@ -79,6 +90,9 @@ public:
     void upload(const Mesh& mesh, const cv::Mat& textureBgr);
     // Renders the uploaded mesh with the given camera (the background alone when nothing was uploaded).
     RenderResult render(const RenderCamera& camera);
+    // The same render as one BGRA image (lit colour, coverage as alpha) written into `bgra` (reallocated only when
+    // the size changes): the cheapest read-back, for a render shown on screen every frame. No depth is made.
+    void renderBgra(const RenderCamera& camera, cv::Mat& bgra);
 
     // Vertex and triangle counts of the uploaded mesh (0 before upload()).
     std::size_t vertexCount() const { return vertexCount_; }
@@ -97,7 +111,10 @@ private:
     void destroyTargets();
     void ensureTargets(int width, int height);
     void releaseAll();
+    void drawScene(const RenderCamera& camera, bool withDepth);
 
+    Options options_;
+    cv::Mat readBuffer_;  // renderBgra's GL-order read-back, kept between frames
     std::unique_ptr<HeadlessEglContext> ownedContext_;
     HeadlessEglContext* context_ = nullptr;
     std::unique_ptr<Gl> gl_;

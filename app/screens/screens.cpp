@@ -149,6 +149,12 @@ cv::Point2d ScreenRenderer::previewToScreen(cv::Point2d p, cv::Size frame) const
 }
 
 const cv::Mat& ScreenRenderer::draw(const ScreenModel& m, const ScreenInputs& in) {
+    ScreenModel timeless = m;
+    timeless.sinceEntered = Millis(0);
+    if (m.id == ScreenId::Reveal && in.avatarVersion != 0 && revealShown_ &&
+        revealShown_->avatarVersion == in.avatarVersion && revealShown_->model == timeless)
+        return canvas_;  // the very picture drawn last time: the avatar holds its pose
+    revealShown_.reset();
     switch (m.id) {
         case ScreenId::Attract: attract(m, in); break;
         case ScreenId::FrontGuide:
@@ -164,6 +170,8 @@ const cv::Mat& ScreenRenderer::draw(const ScreenModel& m, const ScreenInputs& in
     }
     if (m.id != ScreenId::CameraLost && m.id != ScreenId::OperatorMenu && m.id != ScreenId::CaptureFlash)
         drawBanner(m);
+    if (m.id == ScreenId::Reveal && in.avatarVersion != 0)
+        revealShown_ = RevealShown{in.avatarVersion, timeless};
     return canvas_;
 }
 
@@ -220,9 +228,13 @@ void ScreenRenderer::drawImageFitted(const cv::Mat& image, cv::Rect box, bool mi
     const double s = std::min(static_cast<double>(box.width) / image.cols, static_cast<double>(box.height) / image.rows);
     const cv::Size size(std::max(1, static_cast<int>(image.cols * s)), std::max(1, static_cast<int>(image.rows * s)));
     cv::Mat resized;
-    // Bilinear down to half size (4x cheaper than area averaging, and the images are photos and renders without
-    // fine patterns); area averaging below that, where bilinear would alias.
-    cv::resize(image, resized, size, 0, 0, s < 0.5 ? cv::INTER_AREA : cv::INTER_LINEAR);
+    if (size == image.size() && !mirror) {
+        resized = image;  // rendered at the size shown (the avatar): nothing to scale
+    } else {
+        // Bilinear down to half size (4x cheaper than area averaging, and the images are photos and renders without
+        // fine patterns); area averaging below that, where bilinear would alias.
+        cv::resize(image, resized, size, 0, 0, s < 0.5 ? cv::INTER_AREA : cv::INTER_LINEAR);
+    }
     if (mirror) cv::flip(resized, resized, 1);
     const cv::Rect at(box.x + (box.width - size.width) / 2, box.y + (box.height - size.height) / 2, size.width,
                       size.height);
@@ -238,6 +250,7 @@ void ScreenRenderer::drawImageFitted(const cv::Mat& image, cv::Rect box, bool mi
             uchar* d = dst.ptr(y);
             for (int x = 0; x < src.cols; ++x, s4 += 4, d += 3) {
                 const int a = s4[3];
+                if (a == 0) continue;  // most of an avatar's square is background
                 for (int k = 0; k < 3; ++k) d[k] = static_cast<uchar>((s4[k] * a + d[k] * (255 - a) + 127) / 255);
             }
         }
@@ -330,6 +343,13 @@ cv::Rect ScreenRenderer::avatarArea(ScreenId screen) const {
     return cv::Rect(L.middle.x, L.top.br().y, L.middle.width, L.middle.br().y - L.top.br().y);
 }
 
+std::vector<cv::Rect> ScreenRenderer::avatarImageBoxes(ScreenId screen, int count) const {
+    std::vector<cv::Rect> boxes = avatarCells(avatarArea(screen), count);
+    if (count > 1)
+        for (cv::Rect& b : boxes) b.height = std::max(0, b.height - labelHeight());
+    return boxes;
+}
+
 std::vector<cv::Rect> ScreenRenderer::avatarCells(cv::Rect area, int count) {
     std::vector<cv::Rect> cells;
     if (count <= 0 || area.empty()) return cells;
@@ -380,7 +400,7 @@ void ScreenRenderer::drawAvatars(const ScreenInputs& in, ScreenId screen) {
     for (std::size_t i = 0; i < in.avatars.size(); ++i) {
         const StyledAvatar& a = in.avatars[i];
         cv::Rect cell = cells[i];
-        const int labelH = labelled ? static_cast<int>(40 * u) : 0;
+        const int labelH = labelled ? labelHeight() : 0;
         const cv::Rect label(cell.x, cell.br().y - labelH, cell.width, labelH);
         cell.height -= labelH;
         if (a.image.empty()) {
@@ -519,15 +539,22 @@ void ScreenRenderer::processing(const ScreenModel& m) {
 }
 
 void ScreenRenderer::reveal(const ScreenInputs& in) {
-    const double u = layout_.unit;
-    drawBackground();
-    const ScreenLayout& L = layout_;
+    if (revealLayer_.empty()) {
+        // Text is the costly part of a screen (FreeType, wrapping): the reveal's title and buttons never change, so
+        // they are drawn once (the avatars' places lie between them, never under them).
+        const double u = layout_.unit;
+        drawBackground();
+        const ScreenLayout& L = layout_;
+        drawText(str("reveal.title"), L.top + cv::Point(0, static_cast<int>(10 * u)), static_cast<int>(64 * u),
+                 kAccent, FontWeight::Bold);
+        const bool startLeft = settings_.startButtonOnLeft;
+        drawButtonLabel(str("reveal.keep"), startLeft ? L.leftLabel : L.rightLabel, true);
+        drawButtonLabel(str("reveal.retake"), startLeft ? L.rightLabel : L.leftLabel, false);
+        canvas_.copyTo(revealLayer_);
+    } else {
+        revealLayer_.copyTo(canvas_);
+    }
     drawAvatars(in, ScreenId::Reveal);
-    drawText(str("reveal.title"), L.top + cv::Point(0, static_cast<int>(10 * u)), static_cast<int>(64 * u), kAccent,
-             FontWeight::Bold);
-    const bool startLeft = settings_.startButtonOnLeft;
-    drawButtonLabel(str("reveal.keep"), startLeft ? L.leftLabel : L.rightLabel, true);
-    drawButtonLabel(str("reveal.retake"), startLeft ? L.rightLabel : L.leftLabel, false);
 }
 
 void ScreenRenderer::retakeChoice(const ScreenInputs& in) {

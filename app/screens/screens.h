@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -59,6 +60,9 @@ struct ScreenInputs {
     // shown instead of `avatar`.
     std::vector<StyledAvatar> avatars;
     cv::Mat stage;                   // the tile stage (BGRA), drawn in ScreenLayout::stage under the avatars
+    // Changes whenever the avatar image changes; 0: unknown (the screen is composed afresh every time). With a
+    // version, a reveal whose avatar has not changed is not composed again.
+    std::uint64_t avatarVersion = 0;
     cv::Mat frontPhoto, sidePhoto;   // the photos taken (BGR; may be empty): the retake question
     OperatorInfo operatorInfo;       // the operator menu
 };
@@ -104,6 +108,10 @@ public:
     // sees a mirror) and scaled to fill the screen, centred, cropping what does not fit.
     cv::Point2d previewToScreen(cv::Point2d cameraPx, cv::Size frame) const;
 
+    // Where each of `count` avatars is shown on the attract or reveal screen (the cell less its label): an avatar
+    // image of min(width, height) pixels square is shown there without rescaling.
+    std::vector<cv::Rect> avatarImageBoxes(ScreenId screen, int count) const;
+
 private:
     void drawBackground();
     void drawPreview(const cv::Mat& preview, bool ovalLit, bool profile);
@@ -113,6 +121,7 @@ private:
     void drawButtonLabel(const std::string& text, cv::Rect box, bool startButton);
     void drawImageFitted(const cv::Mat& image, cv::Rect box, bool mirror = false);
     void drawAvatars(const ScreenInputs& in, ScreenId screen);
+    int labelHeight() const { return static_cast<int>(40 * layout_.unit); }  // a style's name under its avatar
     void drawProfileOutline(cv::Rect box, bool noseRight, cv::Scalar colour, int thickness);
 
     void attract(const ScreenModel& m, const ScreenInputs& in);
@@ -138,6 +147,14 @@ private:
         int width = 0, ascent = 0;
     };
     std::map<std::string, BigText> bigText_;  // the countdown's numbers
+    // The reveal without its avatar and banner (background, title, button labels: the same every frame), and what
+    // the canvas holds after the last reveal drawn: its avatar version and banner.
+    cv::Mat revealLayer_;
+    struct RevealShown {
+        std::uint64_t avatarVersion = 0;
+        ScreenModel model;  // with sinceEntered 0: the reveal draws nothing that moves with time but the avatar
+    };
+    std::optional<RevealShown> revealShown_;
     cv::Mat outsideOval_;       // 255 outside the oval, for the last preview size
     cv::Size outsideOvalFor_;   // the preview size outsideOval_ was made for
 };

@@ -98,6 +98,15 @@ void EglWindowSurface::attach(void* nativeWindow) {
     renderer_ = renderer != nullptr ? renderer : "(unknown)";
 }
 
+void EglWindowSurface::makeCurrent() {
+    const auto display = static_cast<EGLDisplay>(display_);
+    const auto surface = static_cast<EGLSurface>(surface_);
+    const auto context = static_cast<EGLContext>(context_);
+    if (eglGetCurrentContext() == context && eglGetCurrentSurface(EGL_DRAW) == surface) return;
+    if (!eglMakeCurrent(display, surface, surface, context))
+        throw BoothError(ErrorKind::Device, who_, eglFailure("eglMakeCurrent"));
+}
+
 void EglWindowSurface::swap() {
     if (!eglSwapBuffers(static_cast<EGLDisplay>(display_), static_cast<EGLSurface>(surface_)))
         throw BoothError(ErrorKind::Device, who_, eglFailure("eglSwapBuffers"));

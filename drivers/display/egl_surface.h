@@ -22,6 +22,9 @@ public:
     // Creates the window surface on `nativeWindow` (as EGL_EXT_platform_base wants it: gbm_surface*, or a pointer
     // to the X11 Window) and a GLES 2 context, and makes them current.
     void attach(void* nativeWindow);
+    // Makes the surface and its context current again: the kiosk's offscreen renders (the avatar) make their own
+    // context current on the same thread between two frames. Throws on failure.
+    void makeCurrent();
     // eglSwapBuffers; throws on failure.
     void swap();
     const std::string& renderer() const { return renderer_; }

@@ -228,6 +228,7 @@ cv::Size KmsDisplay::size() const {
 void KmsDisplay::present(const cv::Mat& bgr) {
     State& s = *state_;
     const cv::Size panel(s.output.mode.hdisplay, s.output.mode.vdisplay);
+    s.egl->makeCurrent();
     s.presenter->draw(bgr, panel, rotation_);
     s.egl->swap();
     gbm_bo* next = gbm_surface_lock_front_buffer(s.surface);

@@ -95,6 +95,7 @@ WindowDisplay::~WindowDisplay() = default;
 
 void WindowDisplay::present(const cv::Mat& bgr) {
     State& s = *state_;
+    s.egl->makeCurrent();
     s.presenter->draw(bgr, s.windowSize, rotation_);
     s.egl->swap();
 }

@@ -160,13 +160,24 @@ TEST(RevealStyles, CharacterToonAndStageOnTheRevealThenTheStripIsKept) {
     inputs.sideMask = visitor.sideMask;
     inputs.sideNoseImageRight = SyntheticVisitorOptions{}.sideNoseImageRight;
     inputs.sideChinRow = static_cast<int>(visitor.v.sideLandmarks.at("chin").y) + 1;
-    inputs.characterMesh = character.mesh;
-    inputs.characterTexture = character.texture;
     styles.visitor(inputs);
 
-    // At once: the toon's place is there, empty, while it is drawn; the reveal is not complete yet.
+    // At once: the character's place is there, empty, until the kiosk hands over the visitor's character (never
+    // the previous one's); the toon's place is there, empty, while it is drawn; the reveal is not complete yet.
+    std::uint64_t version = styles.version();
     styles.fill(in, /*reveal=*/true, 0ms, layout);
     ASSERT_EQ(in.avatars.size(), 3u);
+    EXPECT_TRUE(in.avatars[1].image.empty());
+    EXPECT_FALSE(styles.complete());
+    EXPECT_NE(styles.version(), version);  // a style's image went
+    styles.fill(in, /*reveal=*/false, 0ms, layout);
+    EXPECT_EQ(in.avatars.size(), 1u);  // attract: no empty places
+    styles.visitorCharacter(character.mesh, character.texture);
+    version = styles.version();
+    styles.fill(in, /*reveal=*/true, 0ms, layout);
+    ASSERT_EQ(in.avatars.size(), 3u);
+    EXPECT_GT(alphaCoverage(in.avatars[1].image), 0.15);
+    EXPECT_NE(styles.version(), version);
     const bool drawnAlready = !in.avatars[2].image.empty();
     EXPECT_EQ(styles.complete(), drawnAlready);
     for (int i = 0; i < 600 && !styles.toonSettled(); ++i) std::this_thread::sleep_for(50ms);
@@ -194,6 +205,9 @@ TEST(RevealStyles, CharacterToonAndStageOnTheRevealThenTheStripIsKept) {
     EXPECT_EQ(after.characterRenders, before.characterRenders);
     EXPECT_EQ(after.toonRenders, before.toonRenders);
     EXPECT_EQ(after.stageRenders, before.stageRenders);
+    const std::uint64_t held = styles.version();
+    styles.fill(in, true, 3000ms, layout);
+    EXPECT_EQ(styles.version(), held);  // nothing changed: the screen need not compose the reveal again
     std::printf("per render (medians, this machine): character %.1f ms, toon %.1f ms, stage %.1f ms; toon drawn in %.2f s\n",
                 after.characterMs, after.toonMs, after.stageMs, after.toonBuildSeconds);
 
