@@ -106,6 +106,26 @@ VisitorScript::Action SimVisitor::step(const ScreenModel& screen, FlowTime now) 
     return a;
 }
 
+namespace {
+
+// "8s" or "8" (seconds, > 0, at most an hour) for an item of --visitor-does.
+Millis parseSeconds(const std::string& item, std::string value) {
+    if (!value.empty() && value.back() == 's') value.pop_back();
+    double seconds = 0.0;
+    std::size_t used = 0;
+    try {
+        seconds = std::stod(value, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != value.size() || !(seconds > 0.0) || seconds > 3600.0)
+        throw BoothError(ErrorKind::BadInput, "--visitor-does",
+                         "\"" + item + "\": the time must be seconds between 0 and 3600, e.g. look-at-avatar=8s");
+    return Millis(static_cast<long long>(seconds * 1000.0));
+}
+
+}  // namespace
+
 SimVisitorScript parseSimVisitorScript(const std::string& list) {
     SimVisitorScript script;
     std::stringstream in(list);
@@ -114,9 +134,11 @@ SimVisitorScript parseSimVisitorScript(const std::string& list) {
         if (item == "retake-side") script.retakeSideOnce = true;
         else if (item == "unplug-camera") script.unplugCameraOnce = true;
         else if (item == "operator-menu") script.operatorFirst = true;
+        else if (item.rfind("look-at-avatar=", 0) == 0) script.lookAtAvatarFor = parseSeconds(item, item.substr(15));
         else if (!item.empty())
             throw BoothError(ErrorKind::BadInput, "--visitor-does",
-                             "unknown item \"" + item + "\" (retake-side, unplug-camera, operator-menu)");
+                             "unknown item \"" + item +
+                                 "\" (retake-side, unplug-camera, operator-menu, look-at-avatar=SECONDSs)");
     }
     return script;
 }

@@ -26,7 +26,8 @@ struct SimVisitorScript {
 };
 
 // Reads a comma-separated list of what the simulated visitor does besides a plain session ("retake-side",
-// "unplug-camera", "operator-menu"); throws BoothError(BadInput) naming an unknown item.
+// "unplug-camera", "operator-menu", "look-at-avatar=8s": on the reveal that long before deciding); throws
+// BoothError(BadInput) naming an unknown item or a bad time.
 SimVisitorScript parseSimVisitorScript(const std::string& list);
 
 class SimVisitor final : public VisitorScript {

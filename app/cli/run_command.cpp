@@ -80,7 +80,8 @@ void registerRunCommand(CLI::App& app) {
     cmd->add_option("--visitor-does", o->visitorDoes,
                     "What the simulated visitor does besides one plain session, comma-separated: retake-side (asks "
                     "to retake the side photo once), unplug-camera (the camera vanishes in the front guide and comes "
-                    "back), operator-menu (an operator opens the menu with the lock first and frees disk)");
+                    "back), operator-menu (an operator opens the menu with the lock first and frees disk), "
+                    "look-at-avatar=SECONDSs (on the reveal that long before keeping; default 3s)");
     cmd->callback([o] {
         spdlog::set_level(spdlog::get_level() > spdlog::level::info ? spdlog::level::info : spdlog::get_level());
         BoothConfig config;

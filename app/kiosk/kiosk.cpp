@@ -613,7 +613,9 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     RetentionReport lastFreed;  // what the operator's last "free disk" removed (shown in the menu)
     bool screenshotDue = !options.screenshots.empty();
     int screenshotIndex = 0;
-    int hintlessGuideShot = -1;  // the index of a guide's screenshot taken before its first hint was known
+    // The index of a screenshot taken before its screen had everything it shows (a guide before its first hint, a
+    // reveal before the toon was drawn): taken again, under the same name, once it has.
+    int provisionalShot = -1;
     std::vector<std::pair<Button, FlowTime>> releases;  // simulated presses to release
     auto lastRetention = std::chrono::steady_clock::now();
     // Benchmark figures.
@@ -1002,7 +1004,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         if (screen.id != lastScreen || (screen.id == ScreenId::OperatorMenu && screen.menuPage != lastMenuPage)) {
             lastMenuPage = screen.menuPage;
             screenshotDue = !options.screenshots.empty();
-            hintlessGuideShot = -1;
+            provisionalShot = -1;
         }
         // A screen's picture once it has what it shows: the preview on guides, the avatar on the reveal. A guide
         // whose first hint was not known yet (the first analysis is slow on a slow board) is taken again, under the
@@ -1011,9 +1013,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         if (guide && (screen.id != lastScreen || screen.hint != lastHint))
             spdlog::info("{}: hint {}", toString(screen.id), toString(screen.hint));
         lastHint = screen.hint;
-        if (hintlessGuideShot >= 0 && screen.hint != Hint::None) {
-            writeScreenshot(options.screenshots, hintlessGuideShot, screen, drawn, report, true);
-            hintlessGuideShot = -1;
+        const bool everythingShown = guide ? screen.hint != Hint::None : screen.id != ScreenId::Reveal || styles->complete();
+        if (provisionalShot >= 0 && everythingShown) {
+            writeScreenshot(options.screenshots, provisionalShot, screen, drawn, report, true);
+            provisionalShot = -1;
         }
         const bool complete = (!previewScreen || (!inputs.preview.empty() && screen.sinceEntered >= Millis(700))) &&
                               // (every style drawn: the character always comes, made right after the fit; a toon
@@ -1024,7 +1027,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                               (screen.id != ScreenId::Thanks || !screen.code.empty());
         lastScreen = screen.id;
         if (screenshotDue && complete) {
-            if (guide && screen.hint == Hint::None) hintlessGuideShot = screenshotIndex;
+            if (!everythingShown) provisionalShot = screenshotIndex;
             writeScreenshot(options.screenshots, screenshotIndex++, screen, drawn, report);
             screenshotDue = false;
         }

@@ -52,8 +52,10 @@ TEST(KioskSim, RevealShowsCharacterAndToonAndAttractTheStage) {
                           << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n"
                           << "[reveal]\nstyles = [\"photo\", \"character\", \"toon\"]\ntoon_strip_frames = 12\n"
                           << "[stage]\nenabled = true\n";
+    // The visitor looks at their avatars long enough for the toon to be drawn on a busy machine (the reveal's
+    // screenshot is taken again once every style is there).
     const CommandResult r = runAvatarbooth("run --config " + config.string() + " --sessions 1 --screenshots " +
-                                           (dir / "screens").string());
+                                           (dir / "screens").string() + " --visitor-does look-at-avatar=12s");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     std::smatch m;
     ASSERT_TRUE(std::regex_search(r.output, m, std::regex("kept: ([2-9A-Z]{6})"))) << r.output;
