@@ -5,14 +5,17 @@
 
 namespace avatarbooth {
 
-AvatarStage::AvatarStage(const AnimationSettings& animation, AvatarStageOptions options)
-    : renderer_(MeshRenderer::Options{options.samples, false, options.maxTextureSize}),
+AvatarStage::AvatarStage(const AnimationSettings& animation, AvatarStageOptions options, HeadlessEglContext* context)
+    : renderer_(context ? std::make_unique<MeshRenderer>(
+                              *context, MeshRenderer::Options{options.samples, false, options.maxTextureSize})
+                        : std::make_unique<MeshRenderer>(
+                              MeshRenderer::Options{options.samples, false, options.maxTextureSize})),
       reveal_(playAnimation(revealMotion(), animation)),
       attract_(playAnimation(attractMotion(), animation)),
       fps_(animation.fps) {}
 
 void AvatarStage::show(const Mesh& mesh, const cv::Mat& texture) {
-    renderer_.upload(mesh, texture);
+    renderer_->upload(mesh, texture);
     glm::dvec3 lo, hi;
     mesh.bounds(lo, hi);
     centre_ = (lo + hi) * 0.5;
@@ -39,7 +42,7 @@ const cv::Mat& AvatarStage::frame(bool reveal, Millis since, int size) {
     const glm::dvec3 up = glm::normalize(glm::dvec3(inverse * glm::dvec4(0.0, 1.0, 0.0, 0.0)));
     RenderCamera camera = RenderCamera::orthographic(eye, target, up, extent_ * 0.85 / size, size, size);
     camera.background = cv::Scalar(0, 0, 0);
-    renderer_.renderBgra(camera, image_);
+    renderer_->renderBgra(camera, image_);
     shown_ = key;
     ++version_;
     lastRenderSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace avatarbooth {
@@ -26,7 +27,10 @@ struct AvatarStageOptions {
 // Not thread-safe: its GL context belongs to the thread that made it.
 class AvatarStage {
 public:
-    AvatarStage(const AnimationSettings& animation, AvatarStageOptions options = {});
+    // `context`: a GL context to render through (the kiosk shares one among its offscreen renders; it must outlive
+    // the stage); its own when null.
+    explicit AvatarStage(const AnimationSettings& animation, AvatarStageOptions options = {},
+                         HeadlessEglContext* context = nullptr);
 
     // Uploads the head to show from now on (the fitted visitor, or the base head before any visitor).
     void show(const Mesh& mesh, const cv::Mat& texture);
@@ -41,11 +45,11 @@ public:
     // The time of the last render (render + read-back), and how many were made.
     double lastRenderSeconds() const { return lastRenderSeconds_; }
     std::uint64_t renders() const { return version_; }
-    std::size_t triangleCount() const { return renderer_.triangleCount(); }
-    int samples() const { return renderer_.samples(); }
+    std::size_t triangleCount() const { return renderer_->triangleCount(); }
+    int samples() const { return renderer_->samples(); }
 
 private:
-    MeshRenderer renderer_;
+    std::unique_ptr<MeshRenderer> renderer_;
     std::vector<AnimationFrame> reveal_, attract_;
     double fps_;
     glm::dvec3 centre_{0.0};

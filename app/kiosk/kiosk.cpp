@@ -13,6 +13,7 @@
 #include "drivers/camera/camera_factory.h"
 #include "drivers/camera/reopening_camera.h"
 #include "drivers/display/display_factory.h"
+#include "drivers/display/headless_egl.h"
 #include "drivers/gpio/button_board.h"
 #include "drivers/gpio/clock.h"
 #include "drivers/gpio/lamps.h"
@@ -320,15 +321,18 @@ private:
 // sd_watchdog_enabled(): the convention sd_notify(3) gives), so the pings keep their rate however long one frame
 // takes on a slow board -- but only while the main loop is alive: every loop iteration calls alive(), and when
 // none has for a whole WatchdogSec the pings stop (logged once) and systemd kills and restarts the hung booth.
-// Without a watchdog in the environment it pings once a second (a no-op without NOTIFY_SOCKET).
+// Without a watchdog in the environment (no WatchdogSec, or not under systemd) it sends nothing: pings nobody
+// asked for would only fill a notify socket that is not read.
 class WatchdogPinger {
 public:
     WatchdogPinger() {
         std::uint64_t usec = 0;
-        if (sd_watchdog_enabled(0, &usec) > 0 && usec > 0) {
-            interval_ = std::chrono::microseconds(usec / 2);
-            stalledAfter_ = std::chrono::microseconds(usec);
+        if (sd_watchdog_enabled(0, &usec) <= 0 || usec == 0) {
+            spdlog::info("watchdog: none asked for (no WATCHDOG_USEC), no pings");
+            return;
         }
+        interval_ = std::chrono::microseconds(usec / 2);
+        stalledAfter_ = std::chrono::microseconds(usec);
         alive();
         spdlog::info("watchdog: a ping every {} ms while the main loop runs", std::chrono::duration_cast<std::chrono::milliseconds>(interval_).count());
         thread_ = std::thread([this] { run(); });
@@ -339,7 +343,7 @@ public:
             quit_ = true;
         }
         wake_.notify_all();
-        thread_.join();
+        if (thread_.joinable()) thread_.join();
     }
     void alive() { lastAlive_.store(std::chrono::steady_clock::now().time_since_epoch().count()); }
 
@@ -472,6 +476,30 @@ private:
     std::thread thread_;
 };
 
+// Where one main-loop step spent its time: logged when the step took long enough for the visitor to see the screen
+// stand still (the screen runs at 30 fps), so that an operator's log says which part stalled it.
+class StepTimer {
+public:
+    void mark(const char* part) {
+        const auto t = std::chrono::steady_clock::now();
+        parts_.emplace_back(part, Seconds(t - last_).count());
+        last_ = t;
+    }
+    void reportIfSlow(const char* screen) const {
+        const double total = Seconds(last_ - start_).count();
+        if (total < kSlowStep) return;
+        std::string parts;
+        for (const auto& [name, seconds] : parts_)
+            if (seconds >= 0.005) parts += fmt::format("{}{} {:.0f} ms", parts.empty() ? "" : ", ", name, 1000.0 * seconds);
+        spdlog::warn("slow main-loop step on {}: {:.0f} ms ({})", screen, 1000.0 * total, parts);
+    }
+
+private:
+    static constexpr double kSlowStep = 0.5;  // seconds
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_ = start_;
+    std::vector<std::pair<const char*, double>> parts_;
+};
+
 // spdlog pattern with the visitor session's id on every line ("-" between sessions).
 void setLogSession(const std::string& id) {
     spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%l] [session " + (id.empty() ? std::string("-") : id) + "] %v");
@@ -562,7 +590,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     FitWorker fitter(config.fit.settings, configuredBaseHead(config.fit), detectorMutex);
     PreviewWorker previews(config.guidance, *detectorMutex);
     bool detectorGiven = false;
-    AvatarStage stage(config.animation);
+    // One GL context for every offscreen render of the main thread (the avatar, the character, the stage): each
+    // llvmpipe context costs memory and threads of its own.
+    HeadlessEglContext offscreen;
+    AvatarStage stage(config.animation, AvatarStageOptions{}, &offscreen);
     SessionWriter writer;  // after the fitter: it writes with the fitter's pipeline
     std::unique_ptr<RevealStyles> styles;
     // The avatars' places on the reveal: the photo avatar (the first) and the other styles are rendered at the size
@@ -575,7 +606,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         const std::vector<cv::Rect> places = screens.avatarImageBoxes(ScreenId::Reveal, styleCount);
         const int styleSize = places.size() > 1 ? std::min(places[1].width, places[1].height) : 400;
         styles = std::make_unique<RevealStyles>(config.reveal, config.stage, config.animation, *base,
-                                                std::max(64, styleSize));
+                                                std::max(64, styleSize), &offscreen);
     }
     std::pair<std::uint64_t, std::uint64_t> shownVersions{0, 0};  // the avatar stage's and the styles' last seen
     std::uint64_t avatarsVersion = 0;                             // changes with either
@@ -604,6 +635,13 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         fs::path folder;
     };
     std::optional<WriteAfterCharacter> awaitingCharacter;
+    // What the current visitor's write was given: a keep after a failed write (disk full) writes it again.
+    struct WriteGiven {
+        std::uint64_t job = 0;
+        std::shared_ptr<const FitOutcome> outcome;
+        std::shared_ptr<const CharacterOutputs> character;
+    };
+    std::optional<WriteGiven> lastWrite;
     fs::path toonStripFor;       // a kept session whose toon is still being drawn (its strip is added when done)
     std::string cameraProblem;
     std::string sessionId;
@@ -638,6 +676,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     };
     // Leaves nothing of the current visitor's folder: removed now when written, else when its write ends.
     const auto dropSessionFolder = [&] {
+        lastWrite.reset();
         if (awaitingCharacter && awaitingCharacter->job == writeJob) awaitingCharacter.reset();  // never written
         else if (written != Written::Writing) discardQuietly(pendingFolder);
         pendingFolder.clear();
@@ -705,8 +744,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             else styles->visitorWithoutCharacter();
         }
         if (awaitingCharacter && awaitingCharacter->job == c.job) {
-            if (const FitPipeline* p = fitter.pipeline())
+            if (const FitPipeline* p = fitter.pipeline()) {
                 writer.submit(c.job, awaitingCharacter->outcome, p, awaitingCharacter->folder, c.outputs);
+                lastWrite = WriteGiven{c.job, awaitingCharacter->outcome, c.outputs};
+            }
             awaitingCharacter.reset();
         }
     };
@@ -754,11 +795,21 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                         // Kept as soon as it is written (the thanks screen shows the code then).
                         spdlog::info("the session is kept once its folder is written");
                         keepJobs.push_back(writeJob);
+                    } else if (written == Written::Failed && lastWrite && lastWrite->job == writeJob &&
+                               fitter.pipeline()) {
+                        // The write failed while the visitor looked (e.g. the disk was full): the fit is still in
+                        // memory, so the keep writes it again (space may have been freed since) and keeps it.
+                        spdlog::warn("the session folder was not written ({}): writing it again for the keep",
+                                     writeFailure);
+                        const fs::path folder = store.pendingPath();
+                        writer.submit(writeJob, lastWrite->outcome, fitter.pipeline(), folder, lastWrite->character);
+                        keepJobs.push_back(writeJob);
                     } else {
                         const std::string why = written == Written::Failed ? writeFailure : "no fitted avatar to keep";
                         spdlog::error("session not kept: {}", why);
                         events.push_back(SessionSaveFailed{why, now});
                     }
+                    lastWrite.reset();
                     pendingFolder.clear();
                     writeJob = 0;
                     written = Written::None;
@@ -800,8 +851,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     for (auto nextFrame = std::chrono::steady_clock::now();; nextFrame += kFramePeriod) {
         if (options.stop && options.stop->load()) break;
         const FlowTime now = FlowClock::now();
+        StepTimer step;
         for (const auto& c : commands) execute(c, now);
         commands.clear();
+        step.mark("commands");
 
         // Buttons, keyboard, and the simulated visitor.
         if (board.keyboard)
@@ -836,6 +889,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             }
         }
 
+        step.mark("buttons");
         // The camera: its state, and the newest preview frame for the guide and the analysis.
         const std::string problem = camera->status().message;
         if (problem != cameraProblem) {
@@ -882,12 +936,13 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             if (shown == ScreenId::FrontGuide || shown == ScreenId::SideGuide) ++analyses;
         }
 
+        step.mark("camera");
         // The fit: started once the model is there and the analysis has let go of the detector.
         if (fitWanted && fitter.pipeline() && previews.release()) {
             (void)previews.take();
             dropSessionFolder();  // a retake: the earlier fit's folder goes
             fitter.submit(++fitJob, frontPhoto, sidePhoto);
-            spdlog::info("fitting");
+            spdlog::info("fitting the photos (fit {})", fitJob);
             fitWanted = false;
         }
         if (auto stageName = fitter.takeStage()) events.push_back(FitProgress{stageProgress(*stageName), *stageName, now});
@@ -920,6 +975,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         // the code at once, and a toon slow to draw on a busy board must not hold the session back).
         if (!toonStripFor.empty() && styles->toonSettled()) addToonStrip();
 
+        step.mark("fit");
         // The flow: every event, then a tick for the timeouts and the countdown.
         events.push_back(Tick{now});
         const ScreenId before = flow.screen().id;
@@ -942,6 +998,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
         lamps.update(clock.now());
 
+        step.mark("flow");
         // The screen.
         const auto drawStart = std::chrono::steady_clock::now();
         ScreenInputs inputs;
@@ -963,6 +1020,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
         const bool rendered = stage.renders() != rendersBefore || styles->version() != stylesBefore;
         const auto renderEnd = std::chrono::steady_clock::now();
+        step.mark("avatars");
         if (screen.id == ScreenId::RetakeChoice) {
             inputs.frontPhoto = frontPhoto;
             inputs.sidePhoto = sidePhoto;
@@ -978,8 +1036,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
         const cv::Mat& drawn = screens.draw(screen, inputs);
         const auto composeEnd = std::chrono::steady_clock::now();
+        step.mark("screen");
         display.present(drawn);
         const auto drawEnd = std::chrono::steady_clock::now();
+        step.mark("present");
         if (screen.id == ScreenId::FrontGuide || screen.id == ScreenId::SideGuide) {
             if (inGuide) {  // frame intervals within one guide
                 ++guideFrames;
@@ -1039,6 +1099,8 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             watchdog.emplace();
         }
 
+        step.mark("screenshots");
+        step.reportIfSlow(toString(screen.id));
         // Housekeeping: the watchdog hears that the loop is alive; retention.
         watchdog->alive();
         const auto wall = std::chrono::steady_clock::now();

@@ -201,6 +201,7 @@ struct RevealStyles::Impl {
 
     std::optional<stage::TileMap> stageMap;  // read at start-up; the view is made for the first band it fills
     std::unique_ptr<stage::StageView> stage;
+    HeadlessEglContext* context = nullptr;  // shared with the kiosk's other offscreen renders (null: their own)
 
     std::vector<double> characterMs, toonMs, stageMs;
     StyleFigures figures;
@@ -229,8 +230,7 @@ struct RevealStyles::Impl {
         const glm::dvec3 up = glm::normalize(glm::dvec3(inverse * glm::dvec4(0.0, 1.0, 0.0, 0.0)));
         RenderCamera camera = RenderCamera::orthographic(eye, target, up, extent * 0.85 / size, size, size);
         camera.background = cv::Scalar(0, 0, 0);
-        const RenderResult r = characterRenderer->render(camera);
-        characterImage = withAlpha(r.bgr, r.mask);
+        characterRenderer->renderBgra(camera, characterImage);
         characterPose = model;
         remember(characterMs, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
         ++figures.characterRenders;
@@ -268,9 +268,11 @@ struct RevealStyles::Impl {
 };
 
 RevealStyles::RevealStyles(const RevealSettings& reveal, const StageSettings& stageSettings,
-                           const AnimationSettings& animation, const BaseHead& base, int avatarSize)
+                           const AnimationSettings& animation, const BaseHead& base, int avatarSize,
+                           HeadlessEglContext* context)
     : impl_(std::make_unique<Impl>()) {
     Impl& s = *impl_;
+    s.context = context;
     s.settings = reveal;
     s.stageSettings = stageSettings;
     s.reveal = playAnimation(revealMotion(), animation);
@@ -278,7 +280,10 @@ RevealStyles::RevealStyles(const RevealSettings& reveal, const StageSettings& st
     s.fps = animation.fps;
     s.size = avatarSize;
     if (reveal.shows(AvatarStyle::Character)) {
-        s.characterRenderer = std::make_unique<MeshRenderer>();
+        // Like the photo avatar (AvatarStage): 2 samples, no depth, a texture no larger than the screen shows.
+        const MeshRenderer::Options options{2, false, 512};
+        s.characterRenderer = context ? std::make_unique<MeshRenderer>(*context, options)
+                                      : std::make_unique<MeshRenderer>(options);
         // Before any visitor: the base head painted as a character, with its own (average) proportions.
         s.showCharacter(base.mesh, paintCharacterTexture(base, 256, CharacterLook{}));
     }
@@ -366,7 +371,8 @@ void RevealStyles::fill(ScreenInputs& in, bool reveal, std::chrono::milliseconds
     if (s.stageMap && !s.stage && !layout.stage.empty()) {
         // Enough copies of the map side by side to fill the band (a square map under a wide screen).
         const int copies = stage::copiesToFill(*s.stageMap, static_cast<double>(layout.stage.width) / layout.stage.height);
-        s.stage = std::make_unique<stage::StageView>(stage::buildStage(stage::repeatAcross(*s.stageMap, copies)));
+        s.stage = std::make_unique<stage::StageView>(stage::buildStage(stage::repeatAcross(*s.stageMap, copies)),
+                                                      100.0, s.context);
     }
     if (s.stage && !layout.stage.empty()) {
         const int before = s.stage->renders();

@@ -25,6 +25,7 @@
 namespace avatarbooth {
 
 struct FitOutcome;
+class HeadlessEglContext;
 
 // What the toon needs of one fit: the photos with their head masks.
 struct StyleInputs {
@@ -46,8 +47,10 @@ class RevealStyles {
 public:
     // `base` shows as the character (painted, neutral proportions) before the first visitor. Throws BoothError
     // (BadConfig) when the stage map cannot be read or parsed (file:line:column).
+    // `context`: the GL context the character and the stage render through (the kiosk's one offscreen context for
+    // its main thread; it must outlive this); their own when null.
     RevealStyles(const RevealSettings& reveal, const StageSettings& stage, const AnimationSettings& animation,
-                 const BaseHead& base, int avatarSize);
+                 const BaseHead& base, int avatarSize, HeadlessEglContext* context = nullptr);
     ~RevealStyles();
 
     // A new visitor's fit: starts drawing their toon (an earlier toon still being drawn is dropped); their character

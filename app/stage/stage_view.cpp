@@ -68,9 +68,13 @@ int copiesToFill(const TileMap& map, double bandAspect) {
     return std::clamp(static_cast<int>(std::lround(bandAspect / aspect)), 1, 8);
 }
 
-StageView::StageView(const Stage& stage, double tileMm) {
+StageView::StageView(const Stage& stage, double tileMm, HeadlessEglContext* context) {
+    // Flat-coloured boxes shown every frame while the camera sweeps: 2 samples smooth their edges enough, and the
+    // depth target is never read.
+    const MeshRenderer::Options options{2, false, 0};
+    renderer_ = context ? std::make_unique<MeshRenderer>(*context, options) : std::make_unique<MeshRenderer>(options);
     mesh_ = stageMesh(stage, tileMm, palette_);  // (in the body: palette_ is constructed after mesh_)
-    renderer_.upload(mesh_, palette_);
+    renderer_->upload(mesh_, palette_);
 }
 
 const cv::Mat& StageView::render(double elevationDeg, cv::Size size) {
@@ -81,7 +85,7 @@ const cv::Mat& StageView::render(double elevationDeg, cv::Size size) {
     const glm::dmat4 blend = blendTransform(angle);
     Mesh deformed = mesh_;
     for (auto& p : deformed.positions) p = glm::dvec3(blend * glm::dvec4(p, 1.0));
-    renderer_.upload(deformed, palette_);
+    renderer_->upload(deformed, palette_);
 
     const double a = glm::radians(angle);
     const glm::dvec3 towardsEye(0.0, std::sin(a), std::cos(a));
@@ -105,11 +109,7 @@ const cv::Mat& StageView::render(double elevationDeg, cv::Size size) {
     RenderCamera camera =
         RenderCamera::orthographic(target + towardsEye * distance, target, up, mmPerPixel, size.width, size.height);
     camera.background = cv::Scalar(0, 0, 0);
-    const RenderResult r = renderer_.render(camera);
-    cv::Mat channels[4];
-    cv::split(r.bgr, channels);
-    channels[3] = r.mask;
-    cv::merge(channels, 4, image_);
+    renderer_->renderBgra(camera, image_);
     angle_ = angle;
     size_ = size;
     ++renders_;

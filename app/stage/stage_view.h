@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include <filesystem>
+#include <memory>
 
 namespace avatarbooth::stage {
 
@@ -28,8 +29,9 @@ int copiesToFill(const TileMap& map, double bandAspect);
 // Not thread-safe (one GL renderer): use from one thread.
 class StageView {
 public:
-    // `tileMm`: size of a tile in the mesh (any: the render is scaled to fit).
-    explicit StageView(const Stage& stage, double tileMm = 100.0);
+    // `tileMm`: size of a tile in the mesh (any: the render is scaled to fit). `context`: a GL context to render
+    // through (the kiosk shares one among its offscreen renders; it must outlive the view); its own when null.
+    explicit StageView(const Stage& stage, double tileMm = 100.0, HeadlessEglContext* context = nullptr);
 
     // The stage seen from the front at elevation `elevationDeg` (0 = level, 90 = straight down), deformed by
     // blendTransform(elevation) first (R(theta) along the 45-degree diagonal). Its width fills `size` (the same scale
@@ -44,7 +46,7 @@ public:
 private:
     Mesh mesh_;
     cv::Mat palette_;
-    MeshRenderer renderer_;
+    std::unique_ptr<MeshRenderer> renderer_;
     cv::Mat image_;
     double angle_ = -1000.0;
     cv::Size size_;
