@@ -547,6 +547,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     // (425 against 382 MB) than with two arenas shared by all.
     mallopt(M_ARENA_MAX, 2);
     setLogSession("");
+    // Where the start-up's time goes (`-v`): the booth must be on the attract screen within 2 s of a restart.
+    const auto startupStep = [&](const char* what) {
+        spdlog::debug("start-up: {} after {:.3f} s", what, Seconds(std::chrono::steady_clock::now() - startup).count());
+    };
     KioskReport report;
     const auto note = [&](const std::string& line) {
         spdlog::info("{}", line);
@@ -559,6 +563,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     OpenedDisplay opened = createDisplay(config.display);
     Display& display = *opened.display;
     note(opened.description);
+    startupStep("display open");
     ScreenSettings screenSettings = config.screen;
     screenSettings.size = display.size();
     ScreenRenderer screens(screenSettings);
@@ -571,6 +576,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     SteadyClock clock;
     ButtonBoard board = openButtonBoard(config.buttons, clock);
     note("buttons: " + board.description);
+    startupStep("camera and buttons open");
     LampDriver lamps(*board.lamps);
 
     SessionStore store(config.sessions);
@@ -580,11 +586,13 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         spdlog::warn("removed {} unfinished session folder(s) left by an earlier run", removed);
     store.applyRetention(std::chrono::system_clock::now());
     if (!options.screenshots.empty()) fs::create_directories(options.screenshots);
+    startupStep("leftovers removed, retention applied");
 
     // --- Workers: the model loads in the background while the attract screen already runs.
     // OpenCV's worker pool is made by the first thread that needs it and its threads inherit that thread's priority:
     // made here, by the main loop's thread, before the workers lower theirs.
     cv::parallel_for_(cv::Range(0, 2 * std::max(1, cv::getNumThreads())), [](const cv::Range&) {});
+    startupStep("OpenCV worker pool made");
     // (Shared: the fitter's State holds it, and that State may outlive this function with the loading thread.)
     auto detectorMutex = std::make_shared<std::mutex>();
     FitWorker fitter(config.fit.settings, configuredBaseHead(config.fit), detectorMutex);
@@ -595,6 +603,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     HeadlessEglContext offscreen;
     AvatarStage stage(config.animation, AvatarStageOptions{}, &offscreen);
     SessionWriter writer;  // after the fitter: it writes with the fitter's pipeline
+    startupStep("workers started");
     std::unique_ptr<RevealStyles> styles;
     // The avatars' places on the reveal: the photo avatar (the first) and the other styles are rendered at the size
     // they are shown (no rescaling, no more pixels than shown for llvmpipe).
@@ -608,6 +617,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         styles = std::make_unique<RevealStyles>(config.reveal, config.stage, config.animation, *base,
                                                 std::max(64, styleSize), &offscreen);
     }
+    startupStep("avatar stage and styles made");
     std::pair<std::uint64_t, std::uint64_t> shownVersions{0, 0};  // the avatar stage's and the styles' last seen
     std::uint64_t avatarsVersion = 0;                             // changes with either
 
@@ -1010,6 +1020,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             // Rendered at the size it is shown (no rescaling), and only when the pose changes.
             const cv::Rect box = screens.avatarImageBoxes(screen.id, styleCount)[0];
             inputs.avatar = stage.frame(screen.id == ScreenId::Reveal, screen.sinceEntered, std::min(box.width, box.height));
+            if (!ready) startupStep("first photo avatar rendered");
             styles->fill(inputs, screen.id == ScreenId::Reveal, screen.sinceEntered, screens.layout());
             // One version for every image shown: the screen is not composed again while none has changed.
             if (stage.version() != shownVersions.first || styles->version() != shownVersions.second) {
@@ -1021,6 +1032,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         const bool rendered = stage.renders() != rendersBefore || styles->version() != stylesBefore;
         const auto renderEnd = std::chrono::steady_clock::now();
         step.mark("avatars");
+        if (!ready) startupStep("first styles and stage band rendered");
         if (screen.id == ScreenId::RetakeChoice) {
             inputs.frontPhoto = frontPhoto;
             inputs.sidePhoto = sidePhoto;
@@ -1037,6 +1049,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         const cv::Mat& drawn = screens.draw(screen, inputs);
         const auto composeEnd = std::chrono::steady_clock::now();
         step.mark("screen");
+        if (!ready) startupStep("first screen composed");
         display.present(drawn);
         const auto drawEnd = std::chrono::steady_clock::now();
         step.mark("present");

@@ -1,7 +1,8 @@
 // The fuzzing seeds' adversarial files (tests/fuzz/corpus/) through the normal build: every one gives a clear
 // error naming the file (or line) and what is wrong, or is read correctly — never a crash or a huge allocation.
 // Truncated JPEG and PNG, a PNG/JPEG/BMP/PPM declaring a huge size, a zero-byte file, a folder named front.jpg,
-// file names that are not UTF-8, broken TOML.
+// file names that are not UTF-8, broken TOML, CSV manifests with missing columns, broken quotes, CRLF, a BOM.
+#include "batch/batch_input.h"
 #include "common/error.h"
 #include "common/image_io.h"
 #include "config/booth_config.h"
@@ -168,4 +169,78 @@ TEST(BadInputFiles, EveryConfigSeedParsesOrNamesTheLine) {
         EXPECT_EQ(error->where().rfind(name + ":", 0), 0u) << name << ": " << error->what();
     }
     EXPECT_GE(seen, 10);
+}
+
+// The manifest seeds (a flags byte choosing the columns, as fuzz_manifest.cpp reads it, then the CSV).
+TEST(BadInputFiles, EveryManifestSeedReadsOrNamesTheFileAndLine) {
+    const fs::path dir = test::scratchDir("bad_input_manifest");
+    std::map<std::string, std::vector<BatchItem>> read;
+    std::map<std::string, BoothError> failed;
+    for (const auto& entry : fs::directory_iterator(corpus("manifest"))) {
+        const std::string name = entry.path().filename().string();
+        const std::string bytes = readAll(entry.path());
+        const unsigned flags = bytes.empty() ? 0u : static_cast<unsigned char>(bytes[0]);
+        const fs::path csv = dir / name / "pairs.csv";
+        fs::create_directories(csv.parent_path());
+        std::ofstream(csv, std::ios::binary) << (bytes.empty() ? std::string() : bytes.substr(1));
+        ManifestColumns columns;
+        if (flags & 1) columns.id = "id";
+        if (flags & 2) columns.background = "background";
+        if (flags & 4) columns.side = {"left", "right"};
+        try {
+            read[name] = readCsvManifest(csv, columns);
+        } catch (const BoothError& e) {
+            EXPECT_EQ(e.kind(), ErrorKind::BadInput) << name << ": " << e.what();
+            EXPECT_EQ(e.where().rfind(csv.string(), 0), 0u) << name << ": the error does not name the file: " << e.what();
+            failed.emplace(name, e);
+        }
+    }
+    ASSERT_GE(read.size() + failed.size(), 15u);
+    // Refused as a whole, naming what is wrong (and the header's line for a missing column).
+    ASSERT_TRUE(failed.count("missing_columns"));
+    EXPECT_NE(std::string(failed.at("missing_columns").what()).find("no column 'side'"), std::string::npos);
+    EXPECT_EQ(failed.at("missing_columns").where(), (dir / "missing_columns" / "pairs.csv").string() + ":1");
+    ASSERT_TRUE(failed.count("missing_id_column"));
+    EXPECT_NE(std::string(failed.at("missing_id_column").what()).find("no column 'id'"), std::string::npos);
+    ASSERT_TRUE(failed.count("unterminated_quote"));
+    EXPECT_EQ(failed.at("unterminated_quote").where(), (dir / "unterminated_quote" / "pairs.csv").string() + ":2");
+    ASSERT_TRUE(failed.count("empty"));
+    EXPECT_EQ(failed.size(), 4u) << "more seeds refused than expected";
+
+    // CRLF, a BOM, quoted fields (a comma, "" and line ends inside quotes), blank lines.
+    ASSERT_EQ(read["crlf"].size(), 2u);
+    EXPECT_EQ(read["crlf"][1].id, "ben");
+    EXPECT_EQ(read["crlf"][1].side.filename(), "s2.jpg");  // no '\r' left on the last field
+    ASSERT_EQ(read["bom"].size(), 1u);
+    EXPECT_EQ(read["bom"][0].id, "anna");
+    ASSERT_EQ(read["bom_crlf_no_final_newline"].size(), 1u);
+    EXPECT_EQ(read["bom_crlf_no_final_newline"][0].background.filename(), "b.png");
+    ASSERT_EQ(read["quoted_fields"].size(), 2u);
+    EXPECT_EQ(read["quoted_fields"][0].id, "an_na");
+    EXPECT_EQ(read["quoted_fields"][0].front.filename(), "\"front\".jpg");
+    EXPECT_EQ(read["quoted_fields"][0].side.filename(), "multi\nline\nside.jpg");
+    EXPECT_EQ(read["quoted_fields"][1].id, "ben");
+    EXPECT_EQ(read["blank_lines_and_lone_cr"].size(), 1u);
+    // Broken rows are items with a problem naming the file and line, never fitted.
+    const auto& rows = read["short_and_long_rows"];
+    ASSERT_EQ(rows.size(), 4u);
+    for (const auto& item : rows) {
+        EXPECT_EQ(item.problemKind, "bad_row") << item.source;
+        EXPECT_NE(item.problem.find("pairs.csv:"), std::string::npos) << item.problem;
+    }
+    // Two sides per row: one item per side column; an empty cell is that item's problem only.
+    ASSERT_EQ(read["two_sides_frmdb"].size(), 4u);
+    EXPECT_EQ(read["two_sides_frmdb"][0].id, "001-left");
+    EXPECT_TRUE(read["two_sides_frmdb"][0].problem.empty());
+    EXPECT_EQ(read["two_sides_frmdb"][2].problemKind, "bad_row");
+    EXPECT_TRUE(read["two_sides_frmdb"][3].problem.empty());
+    // Names that are not UTF-8, "..", a hidden name: ids stay plain folder names inside the output folder.
+    for (const auto& item : read["non_utf8_names"]) {
+        EXPECT_FALSE(item.id.empty());
+        EXPECT_NE(item.id.front(), '.') << item.id;
+        EXPECT_EQ(item.id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_."),
+                  std::string::npos)
+            << item.id;
+    }
+    EXPECT_THROW(requireUniqueIds(read["duplicate_ids"]), BoothError);
 }

@@ -25,21 +25,32 @@ struct SessionsCheck {
     std::vector<std::string> complete;    // codes of complete sessions
     std::vector<std::string> problems;    // one line per incomplete or corrupt session, or stray file
     int leftovers = 0;                    // entries under .pending/ and .trash-* (removed at the next start)
+    std::vector<std::string> leftoverNames;  // those under .pending/ and .trash-*, by name
+    int withToon = 0;                     // complete or not, sessions holding their toon strip (toon/)
 };
 
 // The files every kept session has.
 const std::vector<std::string>& sessionFiles();
 
 // Checks every folder: all of sessionFiles() present and non-empty, no temporary file, session.json and fit.json
-// parse, avatar.glb has a consistent GLB header (the Khronos validator is run separately: validateGlb).
+// parse, avatar.glb has a consistent GLB header (the Khronos validator is run separately: validateGlb), and toon/
+// (the toon strip, added after the keep) absent or whole. A kept session's ".toon.partial-*" (a strip being written
+// when the booth was killed) counts as a leftover.
 SessionsCheck checkSessions(const std::filesystem::path& sessions);
 
 // Runs the Khronos glTF validator (tests/gltf, npm); true when it reports no errors. `report` gets its output.
 bool validateGlb(const std::filesystem::path& glb, std::string* report = nullptr);
 bool haveGltfValidator();
 
-// A fingerprint of every file of a session (name -> size and FNV-1a hash), to show it was not touched.
+// A fingerprint of every file of a session (relative name -> FNV-1a hash; leftovers ".partial-*" left out), to
+// show it was not touched.
 std::map<std::string, std::uint64_t> fingerprint(const std::filesystem::path& folder);
+
+// What changed between two fingerprints of a kept session (empty: nothing). The toon strip may appear after the
+// keep (the keep does not wait for the toon), so a toon/ that was absent before may have appeared; every other
+// file, and a toon/ that was already there, must be exactly as before.
+std::vector<std::string> changesSince(const std::map<std::string, std::uint64_t>& before,
+                                      const std::map<std::string, std::uint64_t>& now);
 
 // The bound for "back serving within 2 s of the fault clearing (or of the restart)". The 2 s is the issue's
 // figure for a booth that has its cores; when the machine is busier than its cores (load average above the core

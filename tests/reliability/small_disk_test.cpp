@@ -54,7 +54,7 @@ dd if=/dev/zero of="$mnt/filler" bs=1k count=$((avail - 200)) status=none
 EGL_PLATFORM=surfaceless "$bin" run --config "$cfg" --sessions 100 >"$out/daemon.log" 2>&1 &
 pid=$!
 wait_for() { for _ in $(seq 1 1800); do grep -q "$1" "$out/daemon.log" && return 0; kill -0 $pid 2>/dev/null || return 1; sleep 0.05; done; return 1; }
-wait_for "fit failed" || { echo "no failed fit"; kill -9 $pid; exit 91; }
+wait_for "session folder was not written" || { echo "no failed write"; kill -9 $pid; exit 91; }
 df -k "$mnt" | tail -1 > "$out/df_full.txt"
 date +%s.%N > "$out/freed_at"
 rm -f "$mnt/filler"

@@ -12,6 +12,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -19,6 +21,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -27,6 +30,45 @@ namespace fs = std::filesystem;
 using namespace avatarbooth;
 
 namespace {
+
+// One sample, taken when a session has ended: the process's figures and the C heap's (glibc mallinfo2, every
+// arena): `heapInUse` is what the program holds (a leak makes it grow), `heapFree` what the allocator keeps free
+// inside its arenas (growth there is fragmentation or arena growth, which flattens, not a leak).
+struct Sample {
+    ProcessFigures process;
+    bool quiet = true;  // nothing pending: no session folder being written in the background (its file is open)
+    double heapInUseMegabytes = 0.0;
+    double heapFreeMegabytes = 0.0;
+};
+
+Sample takeSample() {
+    Sample s;
+    s.process = readProcessFigures();
+    const struct mallinfo2 m = mallinfo2();
+    s.heapInUseMegabytes = static_cast<double>(m.uordblks + m.hblkhd) / (1024.0 * 1024.0);
+    s.heapFreeMegabytes = static_cast<double>(m.fordblks) / (1024.0 * 1024.0);
+    return s;
+}
+
+// Least-squares slope of `value` over the samples [from, end), per 100 sessions (0 with fewer than 3 samples).
+template <typename F>
+double slopePer100(const std::vector<Sample>& s, std::size_t from, F value) {
+    const std::size_t n = s.size() > from ? s.size() - from : 0;
+    if (n < 3) return 0.0;
+    double mx = 0, my = 0;
+    for (std::size_t i = from; i < s.size(); ++i) {
+        mx += static_cast<double>(i);
+        my += value(s[i]);
+    }
+    mx /= static_cast<double>(n);
+    my /= static_cast<double>(n);
+    double sxy = 0, sxx = 0;
+    for (std::size_t i = from; i < s.size(); ++i) {
+        sxy += (static_cast<double>(i) - mx) * (value(s[i]) - my);
+        sxx += (static_cast<double>(i) - mx) * (static_cast<double>(i) - mx);
+    }
+    return 100.0 * sxy / sxx;
+}
 
 // Watches the booth through the visitor's eyes: samples the process each time the attract screen comes back,
 // and clears old kept sessions (after checking them) so that thousands of sessions do not fill the disk.
@@ -40,18 +82,36 @@ public:
         return visitor_.step(screen, now);
     }
 
-    std::vector<ProcessFigures> samples;  // one per session ended
+    std::vector<Sample> samples;  // one per session ended
     int checkedComplete = 0;
     std::vector<std::string> problems;
-    int leftoversSeen = 0;
+    int leftoversSeen = 0;               // pending entries seen at a session's end (writes in flight included)
+    std::vector<std::string> stuck;      // pending entries still there a session later, and kept sessions' partials
+    std::set<std::string> withToon;      // kept sessions seen with their toon strip
 
 private:
     void sessionEnded() {
-        samples.push_back(readProcessFigures());
+        samples.push_back(takeSample());
         const reliability::SessionsCheck check = reliability::checkSessions(sessions_);
         for (const auto& p : check.problems) problems.push_back(p);
-        // Between sessions nothing may be pending: a discarded or failed fit leaves nothing behind.
+        // The session folder is written in the background (SessionWriter), so a folder may still be pending when
+        // the attract screen comes back (its write in flight, a few seconds under load; a discarded one is removed
+        // when the write ends), and still at the next end after a visitor who walked away at once. One still there
+        // a minute after it was first seen is stuck: a discarded or failed fit must leave nothing behind.
+        samples.back().quiet = check.leftovers == 0;
         leftoversSeen += check.leftovers;
+        const auto t = std::chrono::steady_clock::now();
+        std::map<std::string, std::chrono::steady_clock::time_point> now;
+        for (const auto& name : check.leftoverNames) {
+            const auto before = pendingBefore_.find(name);
+            now[name] = before == pendingBefore_.end() ? t : before->second;
+            if (t - now[name] > std::chrono::seconds(60) && reported_.insert(name).second) stuck.push_back(name);
+        }
+        // A '.partial-' inside a kept session is never in flight here (the toon strip is written on this thread).
+        stuck.insert(stuck.end(), static_cast<std::size_t>(check.leftovers) - check.leftoverNames.size(), "a kept session's .partial-*");
+        pendingBefore_ = std::move(now);
+        for (const auto& code : check.complete)
+            if (fs::exists(sessions_ / code / "toon")) withToon.insert(code);
         std::vector<fs::path> kept;
         for (const auto& code : check.complete) kept.push_back(sessions_ / code);
         std::sort(kept.begin(), kept.end(), [](const fs::path& a, const fs::path& b) {
@@ -69,6 +129,8 @@ private:
     fs::path sessions_;
     ScreenId last_ = ScreenId::Attract;
     std::set<std::string> counted_;
+    std::map<std::string, std::chrono::steady_clock::time_point> pendingBefore_;  // pending entry -> first seen
+    std::set<std::string> reported_;
 };
 
 }  // namespace
@@ -129,18 +191,41 @@ int main(int argc, char** argv) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const ProcessFigures end = readProcessFigures();
     const auto& s = probe.samples;
-    const ProcessFigures warm = s.size() > static_cast<std::size_t>(warmup) ? s[static_cast<std::size_t>(warmup)] : end;
+    const std::size_t w = static_cast<std::size_t>(warmup);
+    const ProcessFigures warm = s.size() > w ? s[w].process : end;
+    const ProcessFigures last = s.empty() ? end : s.back().process;
     double peakAfterWarmup = 0.0;
     int minFds = 1 << 30, maxFds = 0, minThreads = 1 << 30, maxThreads = 0;
-    for (std::size_t i = static_cast<std::size_t>(warmup); i < s.size(); ++i) {
-        peakAfterWarmup = std::max(peakAfterWarmup, s[i].rssMegabytes);
-        minFds = std::min(minFds, s[i].openFiles);
-        maxFds = std::max(maxFds, s[i].openFiles);
-        minThreads = std::min(minThreads, s[i].threads);
-        maxThreads = std::max(maxThreads, s[i].threads);
+    int quietSamples = 0;
+    for (std::size_t i = w; i < s.size(); ++i) {
+        peakAfterWarmup = std::max(peakAfterWarmup, s[i].process.rssMegabytes);
+        if (!s[i].quiet) continue;  // a write in flight holds a file open
+        ++quietSamples;
+        minFds = std::min(minFds, s[i].process.openFiles);
+        maxFds = std::max(maxFds, s[i].process.openFiles);
+        minThreads = std::min(minThreads, s[i].process.threads);
+        maxThreads = std::max(maxThreads, s[i].process.threads);
     }
-    if (s.size() <= static_cast<std::size_t>(warmup)) minFds = maxFds = minThreads = maxThreads = 0;
-    const double drift = s.empty() ? 0.0 : s.back().rssMegabytes - warm.rssMegabytes;
+    if (quietSamples == 0) minFds = maxFds = minThreads = maxThreads = 0;
+    const double drift = s.size() > w ? last.rssMegabytes - warm.rssMegabytes : 0.0;
+    const auto rss = [](const Sample& x) { return x.process.rssMegabytes; };
+    const auto inUse = [](const Sample& x) { return x.heapInUseMegabytes; };
+    const auto heapFree = [](const Sample& x) { return x.heapFreeMegabytes; };
+    // The drift's shape: RSS and heap at five points after warm-up (a leak climbs steadily, arena growth flattens),
+    // and the least-squares slope per 100 sessions over all samples after warm-up and over the second half of them.
+    std::string points, heapPoints;
+    if (s.size() > w) {
+        for (int q = 0; q <= 4; ++q) {
+            const std::size_t i = w + (s.size() - 1 - w) * static_cast<std::size_t>(q) / 4;
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%s%zu:%.1f", q ? " " : "", i + 1, s[i].process.rssMegabytes);
+            points += buf;
+            std::snprintf(buf, sizeof buf, "%s%zu:%.1f/%.1f", q ? " " : "", i + 1, s[i].heapInUseMegabytes,
+                          s[i].heapFreeMegabytes);
+            heapPoints += buf;
+        }
+    }
+    const std::size_t half = w + (s.size() > w ? (s.size() - w) / 2 : 0);
     const RandomVisitorTally& t = visitor.tally();
 
     std::printf("soak: sessions run          %d (asked %d, seed %llu, %.1f s, %.2f s per session)\n", ended, sessions,
@@ -149,16 +234,24 @@ int main(int argc, char** argv) {
                 "%d front and %d side retakes\n",
                 t.started, kept, t.walkedAwayInGuide, t.walkedAwayAtReveal, t.retakesFront, t.retakesSide);
     std::printf("soak: crashes               %d\n", crashes);
-    std::printf("soak: sessions checked      %d complete, %zu incomplete or corrupt, %d leftovers seen between sessions\n",
-                probe.checkedComplete, probe.problems.size(), probe.leftoversSeen);
+    std::printf("soak: sessions checked      %d complete (%zu with their toon strip), %zu incomplete or corrupt, "
+                "%d pending seen between sessions (writes in flight), %zu stuck\n",
+                probe.checkedComplete, probe.withToon.size(), probe.problems.size(), probe.leftoversSeen,
+                probe.stuck.size());
     std::printf("soak: rss MB                peak %.1f (whole run), after warm-up (%d sessions) %.1f, final %.1f, "
                 "drift %+.2f, peak after warm-up %.1f\n",
-                end.peakRssMegabytes, warmup, warm.rssMegabytes, s.empty() ? 0.0 : s.back().rssMegabytes, drift,
-                peakAfterWarmup);
-    std::printf("soak: open files            after warm-up %d, final %d, range %d..%d\n", warm.openFiles,
-                s.empty() ? 0 : s.back().openFiles, minFds, maxFds);
+                end.peakRssMegabytes, warmup, warm.rssMegabytes, last.rssMegabytes, drift, peakAfterWarmup);
+    std::printf("soak: rss MB by session     %s\n", points.c_str());
+    std::printf("soak: rss slope MB/100      %+.2f after warm-up, %+.2f over the second half\n", slopePer100(s, w, rss),
+                slopePer100(s, half, rss));
+    std::printf("soak: heap MB by session    %s (in use/free in the arenas)\n", heapPoints.c_str());
+    std::printf("soak: heap slope MB/100     in use %+.2f after warm-up, %+.2f over the second half; free %+.2f\n",
+                slopePer100(s, w, inUse), slopePer100(s, half, inUse), slopePer100(s, w, heapFree));
+    std::printf("soak: open files            after warm-up %d, final %d, range %d..%d (over the %d ends with no "
+                "write in flight)\n", warm.openFiles, last.openFiles, minFds, maxFds, quietSamples);
     std::printf("soak: threads               after warm-up %d, final %d, range %d..%d\n", warm.threads,
-                s.empty() ? 0 : s.back().threads, minThreads, maxThreads);
+                last.threads, minThreads, maxThreads);
+    for (const auto& p : probe.stuck) std::printf("soak: STUCK %s\n", p.c_str());
     for (const auto& p : probe.problems) std::printf("soak: PROBLEM %s\n", p.c_str());
 
     bool ok = true;
@@ -169,7 +262,7 @@ int main(int argc, char** argv) {
     if (crashes != 0) fail("the kiosk crashed");
     if (ended < sessions) fail("fewer sessions than asked");
     if (!probe.problems.empty()) fail("incomplete or corrupt session folders");
-    if (probe.leftoversSeen != 0) fail("pending or half-deleted folders left between sessions");
+    if (!probe.stuck.empty()) fail("pending or half-deleted folders left behind");
     if (drift >= maxDrift) fail("memory drift after warm-up above " + std::to_string(maxDrift) + " MB");
     if (maxFds != minFds) fail("the number of open files changed after warm-up");
     if (maxThreads != minThreads) fail("the number of threads changed after warm-up");
