@@ -2,6 +2,7 @@
 #include "kiosk/kiosk.h"
 
 #include "kiosk/avatar_stage.h"
+#include "kiosk/loop_timing.h"
 #include "kiosk/session_writer.h"
 
 #include "booth/guidance.h"
@@ -797,8 +798,10 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             command);
     };
 
+    LoopTiming loopTiming;  // `-v`: where the loop's time goes, every 5 s
     for (auto nextFrame = std::chrono::steady_clock::now();; nextFrame += kFramePeriod) {
         if (options.stop && options.stop->load()) break;
+        const auto loopStart = std::chrono::steady_clock::now();
         const FlowTime now = FlowClock::now();
         for (const auto& c : commands) execute(c, now);
         commands.clear();
@@ -867,6 +870,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             }
             if (!lastPreview.empty() && !fitWanted) previews.offer(*previewFor, lastPreview, now);
         }
+        const auto cameraEnd = std::chrono::steady_clock::now();
         if (!detectorGiven) {
             if (const FitPipeline* p = fitter.pipeline()) {
                 previews.setDetector(&p->detector());
@@ -1048,6 +1052,7 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
                 spdlog::info("retention: deleted {} photos and {} sessions", r.photosDeleted, r.sessionsDeleted);
             lastRetention = wall;
         }
+        loopTiming.frame(loopStart, {cameraEnd, drawStart, renderEnd, composeEnd, drawEnd, std::chrono::steady_clock::now()});
         if (options.sessions > 0 && report.sessionsEnded >= options.sessions) break;
         if (display.closeRequested()) break;
         std::this_thread::sleep_until(nextFrame + kFramePeriod);
