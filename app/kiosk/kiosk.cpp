@@ -924,8 +924,14 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         }
         if (previewFor) {
             try {
-                while (auto frame = camera->nextFrame(std::chrono::milliseconds(lastPreview.empty() ? 30 : 0)))
+                // The newest frame, but at most a queue's worth per loop: where converting a frame takes longer than
+                // the camera takes to make the next (a slow board, emulation, a loaded machine), "until none is
+                // waiting" never ended, and the screen and the watchdog stood still (seconds under qemu).
+                for (int i = 0; i < std::max(1, config.camera.bufferCount); ++i) {
+                    auto frame = camera->nextFrame(std::chrono::milliseconds(lastPreview.empty() && i == 0 ? 30 : 0));
+                    if (!frame) break;
                     lastPreview = frame->image;
+                }
             } catch (const BoothError& e) {
                 spdlog::debug("preview: {}", e.what());
             }

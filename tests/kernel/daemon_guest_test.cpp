@@ -1,9 +1,9 @@
 // The booth daemon end to end in the guest: `avatarbooth run` with the vivid camera, gpio-sim buttons and the
 // headless display goes from attract to the front guide on a press of the start button made with the sim's `pull`
 // attribute; vivid shows no face, so the guide says so (its screenshot's hint text is the "no face" one, from the
-// face cascade alone: the landmark model is still loading, minutes under emulation) and never counts down, and the
-// booth stays up -- systemd watchdog pings (WATCHDOG_USEC=4 s: one every 2 s) keep coming on our own NOTIFY_SOCKET --
-// until SIGTERM, which ends it promptly with exit code 0 although the model load has not finished.
+// face cascade alone: the landmark model is still loading -- a named pipe that never delivers it) and never counts
+// down, and the booth stays up -- systemd watchdog pings (WATCHDOG_USEC=10 s, the shipped unit's: one every 5 s) keep coming on our own
+// NOTIFY_SOCKET -- until SIGTERM, which ends it promptly with exit code 0 although the model load has not finished.
 #include "kernel_guest.h"
 #include "kiosk_daemon_checks.h"
 
@@ -13,14 +13,18 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -35,7 +39,9 @@ using test::NotifySocket;
 
 const fs::path kConfig = "/sys/kernel/config/gpio-sim/avatarbooth-daemon";
 constexpr const char* kLabel = "avatarbooth-daemon";
-constexpr int kWatchdogUsec = 4000000;
+// The shipped unit's WatchdogSec (systemd/avatarbooth.service): a ping every 5 s while the main loop runs. (Under
+// emulation an attract frame takes 2-5 s, so a stricter watchdog would test the emulator, not the booth.)
+constexpr int kWatchdogUsec = 10000000;
 
 std::string vividNode() {
     for (const auto& node : listV4l2Nodes()) {
@@ -49,13 +55,13 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// DISABLED: measured in the guest (TCG) on 2026-11-22 with the host's two cores shared by other builds (load 12-23):
-// READY after 146 s, the model loaded in 152 s, the press gives the front guide and the "no face" hint (screenshot
-// and log checks pass), no countdown -- but the main loop itself ran at 0.1 frames/s (4-10 s per iteration), so the
-// watchdog pinger rightly withheld pings (WATCHDOG_USEC=4 s) and SIGTERM took 18 s (one iteration, then the
-// teardown). The host twin (tests/e2e/kiosk_daemon_test.cpp) checks the same behaviour at native speed. Run it with
-// --gtest_also_run_disabled_tests (tests/kernel/README.md) on an unloaded machine.
-TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWithoutAFace) {
+// Measured in the guest (TCG) on this 2-core machine shared with other builds (tests/kernel/README.md has the
+// table): READY after 44-86 s, the guide 1-6 s after the press with its loop at 1.6-5.2 frames/s, a ping every 2 s (then with a 4 s watchdog),
+// stopped 1-2 s after SIGTERM; 74-127 s in all. What made it fail before: dlib's deserialisation burning a vCPU (now
+// a named pipe, as in the host twin) and the kiosk draining the camera's queue "until none waits", which never ended
+// while a conversion took longer than vivid's next frame. On a host loaded above ~12 the attract screen's head
+// render (2-5 s a frame under TCG) can still outlast WATCHDOG_USEC and withhold one ping.
+TEST(Daemon, AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWithoutAFace) {
     AVATARBOOTH_REQUIRE_KERNEL_GUEST();
     if (!fs::exists(test::binary())) GTEST_SKIP() << test::binary() << " is not built";
     const char* work = std::getenv("W");
@@ -77,9 +83,25 @@ TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWit
     const std::string node = vividNode();
     ASSERT_FALSE(node.empty());
 
+    // The landmark model: a named pipe the test holds open for writing and never writes (as the host twin does), so
+    // the booth's load blocks in read() for as long as it runs -- "still loading", as a real load is for minutes
+    // under emulation, but without the vCPU dlib's deserialisation would burn beside the main loop. In the guest's
+    // /tmp (a tmpfs): a pipe is the guest kernel's own object.
+    const fs::path model = "/tmp/avatarbooth-daemon-model.fifo";
+    fs::remove(model);
+    ASSERT_EQ(mkfifo(model.c_str(), 0600), 0) << std::strerror(errno);
+    const int writer = open(model.c_str(), O_RDWR | O_CLOEXEC);
+    ASSERT_GE(writer, 0) << std::strerror(errno);
+    struct CloseWriter {
+        int fd;
+        ~CloseWriter() { close(fd); }
+    } closeWriter{writer};
+
     const fs::path config = dir / "booth.toml";
-    std::ofstream(config) << "[camera]\nbackend = \"v4l2\"\ndevice = \"" << node << "\"\n"
-                          << "preview_width = 640\npreview_height = 360\nstill_width = 1280\nstill_height = 720\n"
+    std::ofstream(config) << "[fit]\nlandmark_model = \"" << model.string() << "\"\n"
+                          << "[camera]\nbackend = \"v4l2\"\ndevice = \"" << node << "\"\n"
+                          // A small preview: vivid makes, and the booth converts and analyses, a quarter of the pixels.
+                          << "preview_width = 320\npreview_height = 180\nstill_width = 1280\nstill_height = 720\n"
                           << "[buttons]\nbackend = \"gpiod\"\nchip = \"" << kLabel << "\"\n"
                           << "[[buttons.button]]\nname = \"start\"\noffset = 0\n"
                           << "[[buttons.button]]\nname = \"retake\"\noffset = 1\n"
@@ -90,7 +112,11 @@ TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWit
                           << "[display]\nbackend = \"headless\"\nwidth = 640\nheight = 360\n"
                           // The source tree's strings: the build tree is not installed in the guest.
                           << "[screen]\nstrings_file = \"" << AVATARBOOTH_TEST_SOURCE_DIR << "/app/assets/strings.toml\"\n"
-                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
+                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n"
+                          // What the attract screen turns and nothing more: one avatar (the built-in head), no tile
+                          // stage -- each is llvmpipe's work under emulation, and the test is about the guide.
+                          << "[reveal]\nstyles = [\"photo\"]\n"
+                          << "[stage]\nenabled = false\n";
 
     NotifySocket notify("guest");
     ASSERT_TRUE(notify.ok()) << std::strerror(errno);
@@ -103,7 +129,7 @@ TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWit
         setenv("EGL_PLATFORM", "surfaceless", 1);
         const std::string bin = test::binary().string();
         execl("/bin/sh", "sh", "-c",
-              ("exec '" + bin + "' run --config '" + config.string() + "' --screenshots '" + screens.string() +
+              ("exec '" + bin + "' -v run --config '" + config.string() + "' --screenshots '" + screens.string() +
                "' > '" + log.string() + "' 2>&1")
                   .c_str(),
               static_cast<char*>(nullptr));
@@ -123,11 +149,15 @@ TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWit
         return done();
     };
     // Up and showing the attract screen (READY=1 does not wait for the landmark model; the first frame waits for
-    // Mesa's llvmpipe to start and render the turning head: 88 s measured under emulation on a busy machine).
+    // the booth's start-up and Mesa's llvmpipe to render the turning head: 53-86 s measured under emulation on a
+    // busy machine).
     const auto started = std::chrono::steady_clock::now();
-    const bool attract = waitFor([&] { return fs::exists(screens / "00_attract.png"); }, 300s);
+    // (The first frame's screenshot is written just before READY=1 is sent: wait for both.)
+    const bool attract =
+        waitFor([&] { return fs::exists(screens / "00_attract.png") && !notify.ready.empty(); }, 300s);
     const double startSeconds = secondsSince(started);
-    double guideSeconds = 0.0, stopSeconds = 0.0;
+    double guideSeconds = 0.0, stopSeconds = 0.0, longestGap = 0.0;
+    int guidePings = 0;
     bool guide = false;
     if (attract) {
         EXPECT_EQ(notify.ready.size(), 1u);
@@ -141,12 +171,14 @@ TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWit
         guideSeconds = secondsSince(pressed);
         // The first analysis's hint (the screenshot is taken again with it when it came later than the picture).
         waitFor([&] { return readFile(log).find("front_guide: hint no_face") != std::string::npos; }, 60s);
-        // It stays in the guide: no face, so no countdown, and the watchdog pings keep coming, one every 2 s.
+        // It stays in the guide: no face, so no countdown, and the watchdog pings keep coming, one every 5 s.
         const auto from = std::chrono::steady_clock::now();
-        waitFor([] { return false; }, 8s);
+        waitFor([] { return false; }, 12s);
         const auto to = std::chrono::steady_clock::now();
-        EXPECT_GE(notify.pingsSince(from), 3) << "watchdog pings stopped";
-        EXPECT_LT(notify.longestGapSeconds(from, to), kWatchdogUsec / 1e6) << "a watchdog ping came too late";
+        guidePings = notify.pingsSince(from);
+        longestGap = notify.longestGapSeconds(from, to);
+        EXPECT_GE(guidePings, 2) << "watchdog pings stopped";
+        EXPECT_LT(longestGap, kWatchdogUsec / 1e6) << "a watchdog ping came too late";
     }
     if (!gone) {
         const auto term = std::chrono::steady_clock::now();
@@ -158,9 +190,18 @@ TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWit
             waitpid(pid, &status, 0);
         }
     }
-    std::printf("[daemon] attract after %.1f s, front guide %.1f s after the press, stopped %.1f s after SIGTERM\n",
-                startSeconds, guideSeconds, stopSeconds);
+    std::printf("[daemon] attract after %.1f s, front guide %.1f s after the press, %d watchdog pings in 12 s of the "
+                "guide (longest gap %.1f s, %zu in all), stopped %.1f s after SIGTERM\n",
+                startSeconds, guideSeconds, guidePings, longestGap, notify.watchdog.size(), stopSeconds);
     const std::string output = readFile(log);
+    // The booth's own figures (`-v`): its start-up steps and the main-loop steps that took over 0.5 s, with where
+    // their time went.
+    std::istringstream lines(output);
+    for (std::string line; std::getline(lines, line);) {
+        if (line.find("ready in") != std::string::npos || line.find("slow main-loop step") != std::string::npos ||
+            line.find("start-up:") != std::string::npos)
+            std::printf("[daemon] %s\n", line.c_str());
+    }
     ASSERT_TRUE(attract) << "no attract screen\n" << output;
     ASSERT_TRUE(gone) << "did not stop on SIGTERM\n" << output;
     // Under emulation (5-20x slower) the 2 s the host test asks for becomes this.
@@ -174,6 +215,8 @@ TEST(Daemon, DISABLED_AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWit
     EXPECT_GT(test::guideHintMatch(shot, ScreenId::FrontGuide, Hint::NoFace, strings), 0.8) << "no \"no face\" hint";
     EXPECT_LT(test::guideHintMatch(shot, ScreenId::FrontGuide, Hint::None, strings), 0.5);
     EXPECT_NE(output.find("front_guide: hint no_face"), std::string::npos) << output;
+    EXPECT_EQ(output.find("landmark model loaded"), std::string::npos) << output;
+    EXPECT_NE(output.find("still loading"), std::string::npos) << output;
     EXPECT_EQ(output.find("pings withheld"), std::string::npos) << output;
     EXPECT_FALSE(fs::exists(screens / "02_countdown.png")) << "counted down without a face\n" << output;
     EXPECT_NE(output.find("a visitor started a session"), std::string::npos) << output;

@@ -25,7 +25,8 @@ GUEST
 accel="-accel tcg,thread=multi -cpu max"
 rc=0
 # -nic none: the tests need no network. panic=-1 and -no-reboot turn a guest crash into qemu exiting.
-timeout -k 10 "$limit" qemu-system-x86_64 $accel -m 1024 -smp "$(nproc)" -nographic -no-reboot -nic none \
+# debug-threads: the vCPU threads are named ("CPU 0/TCG", ... one per vCPU: multi-threaded TCG) for top -H.
+timeout -k 10 "$limit" qemu-system-x86_64 $accel -name avatarbooth-kernel,debug-threads=on -m 1024 -smp "$(nproc)" -nographic -no-reboot -nic none \
   -kernel "$kdir/vmlinuz" -initrd "$kdir/initrd.img" \
   -append "console=ttyS0 loglevel=4 panic=-1 edd=off rdinit=/init avatarbooth_kernel_guest=1 wdir=$work kroot=$kdir/kroot gscript=$work/guest.sh" \
   -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap \
