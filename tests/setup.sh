@@ -26,6 +26,9 @@ packages=(
   # the `kernel` tests (tests/kernel/): qemu boots Debian's kernel; busybox/cpio/kmod make its initramfs and
   # module tree (modules built with gcc-12/make); v4l-utils, udev, libcamera-ipa/-tools are used inside the guest
   qemu-system-x86 busybox-static cpio kmod xz-utils make gcc-12 libc6-dev v4l-utils udev libcamera-ipa libcamera-tools
+  # the arm64 stage (tests/arm64/, CI runs it after the native tests): cross g++, qemu-user, and mmdebstrap for the
+  # sysroot; listed here too so that a fresh machine installs everything in one apt-get run
+  g++-aarch64-linux-gnu qemu-user mmdebstrap
 )
 missing=()
 for p in "${packages[@]}"; do

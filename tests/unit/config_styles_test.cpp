@@ -42,7 +42,8 @@ TEST(ConfigStyles, ShippedReferenceEqualsTheDefaults) {
 }
 
 TEST(ConfigStyles, ValuesLandInTheirSettings) {
-    const std::filesystem::path dir = avatarbooth::test::scratchDir("config_styles");
+    // A folder of its own per test: ctest runs tests in parallel, and scratchDir() empties the folder it returns.
+    const std::filesystem::path dir = avatarbooth::test::scratchDir("config_styles_values");
     {
         std::ofstream(dir / "island.map") << "ggg\nbbb\n";
     }
@@ -108,7 +109,7 @@ TEST(ConfigStyles, MistakesNameFileLineAndKey) {
 }
 
 TEST(ConfigStyles, ABrokenStageMapNamesItsOwnFileLineAndColumn) {
-    const std::filesystem::path dir = avatarbooth::test::scratchDir("config_styles");
+    const std::filesystem::path dir = avatarbooth::test::scratchDir("config_styles_broken_map");
     {
         std::ofstream(dir / "broken.map") << "# a comment\nggg\ngg?\n";
     }
