@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <tuple>
 
 namespace avatarbooth::toon {
 
@@ -210,8 +211,11 @@ cv::Mat renderToonBgra(const ToonModel& model, double yawDeg, cv::Size size, dou
 }
 
 ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, const cv::Mat& sideBgr,
-                         const cv::Mat& sideMask, bool sideNoseImageRight, int colours, int headHeightPx) {
-    auto prepare = [&](const cv::Mat& bgr, const cv::Mat& mask, bool mirror, const char* which) {
+                         const cv::Mat& sideMask, bool sideNoseImageRight, int colours, int headHeightPx,
+                         const ToonLandmarks& landmarks) {
+    std::vector<cv::Vec3b> frontFeatureColours;
+    std::vector<std::string> frontFeatureNames;
+    auto prepare = [&](const cv::Mat& bgr, const cv::Mat& mask, bool mirror, const char* which, bool isFront) {
         if (bgr.empty() || mask.empty() || cv::countNonZero(mask > 127) == 0)
             throw BoothError(ErrorKind::NoFace, which, "no head mask to draw the toon from");
         const cv::Rect box = cv::boundingRect(mask > 127);
@@ -225,22 +229,51 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
             cv::flip(photo, photo, 1);
             cv::flip(m, m, 1);
         }
-        ToonDrawing drawing = toonDrawing(photo, m, colours);
+        // Photo pixels to drawing pixels: the crop, the scale (pixel centres), the mirror.
+        auto toDrawing = [&](cv::Point2d p) {
+            cv::Point2d q((p.x - padded.x + 0.5) * scale - 0.5, (p.y - padded.y + 0.5) * scale - 0.5);
+            if (mirror) q.x = photo.cols - 1 - q.x;
+            return q;
+        };
+        DrawingGuide guide;
+        if (isFront && landmarks.front) {
+            std::array<cv::Point2d, 68> points;
+            for (std::size_t i = 0; i < points.size(); ++i) points[i] = toDrawing((*landmarks.front)[i]);
+            guide = frontDrawingGuide(points);
+        } else if (!isFront && !landmarks.side.empty()) {
+            std::map<std::string, cv::Point2d> points;
+            for (const auto& [name, p] : landmarks.side) points[name] = toDrawing(p);
+            guide = sideDrawingGuide(points);
+            // The side's face parts in the front's colours: one person's eyes, brows and lips, and the regions match.
+            for (FeatureShape& f : guide.features)
+                for (std::size_t i = 0; i < frontFeatureNames.size(); ++i)
+                    if (frontFeatureNames[i] == f.name) {
+                        f.colour = frontFeatureColours[i];
+                        break;
+                    }
+        }
+        ToonDrawing drawing = toonDrawing(photo, m, colours, 2, guide);
+        if (isFront)
+            for (std::size_t i = 0; i < guide.features.size(); ++i) {
+                frontFeatureNames.push_back(guide.features[i].name);
+                frontFeatureColours.push_back(drawing.featureColours[i]);
+            }
         const cv::Rect b2 = cv::boundingRect(drawing.mask);
-        return std::pair{drawing, cv::Point2d(b2.x + (b2.width - 1) / 2.0, b2.y + (b2.height - 1) / 2.0)};
+        return std::tuple{drawing, cv::Point2d(b2.x + (b2.width - 1) / 2.0, b2.y + (b2.height - 1) / 2.0), guide};
     };
-    auto [front, frontCentre] = prepare(frontBgr, frontMask, false, "front photo");
+    auto [front, frontCentre, frontGuide] = prepare(frontBgr, frontMask, false, "front photo", true);
     // Theta 90 looks from +x (the character's left): the face points to image left, so a nose-right photo flips.
-    auto [side, sideCentre] = prepare(sideBgr, sideMask, sideNoseImageRight, "side photo");
+    auto [side, sideCentre, sideGuide] = prepare(sideBgr, sideMask, sideNoseImageRight, "side photo", false);
     DrawingView a, b;
     a.direction = {0.0, 0.0};
     a.centre = frontCentre;
     b.direction = {90.0, 0.0};
     b.centre = sideCentre;
-    // Photos give many small shading patches that no view shares: keep regions of at least 1/400 of the head's
-    // height squared (a 16 px square at 320 px), the size of an eye's parts.
-    ToonModel model = buildToonModel(front.bgr, front.mask, a, side.bgr, side.mask, b, front.outline, side.outline,
-                                     std::max(30, headHeightPx * headHeightPx / 400));
+    // The drawing already joined shading patches under 1/400 of the head's height squared to their neighbours; what
+    // is smaller now is a face part painted from the landmarks (an iris, a nostril), kept down to 20 pixels.
+    ToonModel model = buildToonModel(front.bgr, front.mask, a, side.bgr, side.mask, b, front.outline, side.outline, 20);
+    model.guideA = frontGuide;
+    model.guideB = sideGuide;
     // The whole head as one more region per view, drawn behind the others: what stays unmatched leaves no hole.
     auto silhouette = [](const ToonDrawing& d, Regions& regions) {
         Region r;
@@ -266,14 +299,18 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
     model.backdropPairs = 1;
     return model;
 }
-ToonModel toonFromPhotoPair(const cv::Mat& frontBgr, const cv::Mat& sideBgr, const cv::Mat& plate, int colours) {
+ToonModel toonFromPhotoPair(const cv::Mat& frontBgr, const cv::Mat& sideBgr, const cv::Mat& plate, int colours,
+                            const std::optional<std::array<cv::Point2d, 68>>& frontLandmarks) {
     const SideAnalysis profile = analyzeSidePhoto(sideBgr, plate);
     // Both photos come from the same camera at the same height: the side photo's chin row cuts both masks to the head.
     const int chin = static_cast<int>(profilePoint(profile.landmarks, "chin").y) + 1;
     cv::Mat frontMask = segmentPerson(frontBgr, plate), sideMask = profile.mask.clone();
     frontMask.rowRange(std::clamp(chin, 0, frontMask.rows), frontMask.rows).setTo(0);
     sideMask.rowRange(std::clamp(chin, 0, sideMask.rows), sideMask.rows).setTo(0);
-    return toonFromPhotos(frontBgr, frontMask, sideBgr, sideMask, profile.noseImageRight, colours);
+    ToonLandmarks landmarks;
+    landmarks.front = frontLandmarks;
+    for (const ProfilePoint& p : profile.landmarks) landmarks.side[p.name] = p.px;
+    return toonFromPhotos(frontBgr, frontMask, sideBgr, sideMask, profile.noseImageRight, colours, 320, landmarks);
 }
 
 std::vector<std::pair<std::string, std::string>> turntableFrames(const ToonModel& model, int frames, cv::Size size,
