@@ -41,9 +41,9 @@ inline std::size_t largestRegion(const toon::Regions& regions) {
     return best;
 }
 
-// Per view: every iris, brow and mouth of the guide is a region of its own at its place (not the skin, under 5 % of
-// the head); the cheeks (the guide's skin samples) are at most two regions of 5 % of them or more, the skin holding
-// 70 % or more. Across views: the front's irises and mouth are matched to the side's iris and mouth.
+// Per view: every iris, brow and mouth of the guide is a region of its own at its place (not the largest region,
+// under 5 % of the head); the cheeks (the guide's skin samples) are at most two regions of 5 % of them or more, one
+// holding 70 % or more. Across views: the front's irises and mouth are matched to the side's iris and mouth.
 inline void expectFaceParts(const toon::ToonModel& model, const std::string& what) {
     auto check = [&](const toon::Regions& regions, const toon::DrawingGuide& guide, const char* view) {
         SCOPED_TRACE(what + ", " + view + " view");
@@ -77,11 +77,13 @@ inline void expectFaceParts(const toon::ToonModel& model, const std::string& wha
                     ++total;
                 }
         ASSERT_GT(total, 50);
-        int big = 0;
-        for (const auto& [label, n] : count)
+        int big = 0, most = 0;
+        for (const auto& [label, n] : count) {
             if (n >= 0.05 * total) ++big;
+            most = std::max(most, n);
+        }
         EXPECT_LE(big, 2) << "the cheeks are cut into " << big << " regions";
-        EXPECT_GE(count[regions.regions[skin].label], 0.7 * total) << "the skin holds too little of the cheeks";
+        EXPECT_GE(most, 0.7 * total) << "no one skin region holds the cheeks";
     };
     check(model.regionsA, model.guideA, "front");
     check(model.regionsB, model.guideB, "side");

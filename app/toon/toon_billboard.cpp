@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <optional>
 #include <tuple>
 
 namespace avatarbooth::toon {
@@ -107,6 +108,8 @@ ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const Dr
 
 namespace {
 
+std::size_t backdropsOf(const ToonModel& model) { return std::min(model.backdropPairs, model.pairs.size()); }
+
 // Draws the billboards into `canvas` (CV_8UC3, its size is the render size) and, when `alpha` is not null, their
 // coverage into *alpha (CV_8U, cleared by the caller).
 void drawToon(const ToonModel& model, double yawDeg, cv::Mat& canvas, cv::Mat* alpha, double unitsPerPixel,
@@ -134,10 +137,34 @@ void drawToon(const ToonModel& model, double yawDeg, cv::Mat& canvas, cv::Mat* a
         const double area = (1.0 - t) * model.regionsA.regions[p.regionA].area + t * model.regionsB.regions[p.regionB].area;
         items.push_back({glm::dot(pos, towards), area, k, pos});
     }
-    // Painter's order: far first; at equal depth the larger region first, so inner parts stay on top.
+    // How deep each region sits inside others in its drawing (regions are drawn with their holes filled: a ring of
+    // hair round the face covers the face unless the face comes after it). Mixed between the views like the rest.
+    auto nesting = [&](const Regions& regions, auto regionOf) {
+        std::vector<double> level(model.pairs.size(), 0.0);
+        for (std::size_t k = backdropsOf(model); k < model.pairs.size(); ++k) {
+            const Region& inner = regions.regions[regionOf(model.pairs[k])];
+            if (inner.contour.empty()) continue;
+            const cv::Point2f probe = inner.contour.front();
+            for (std::size_t j = backdropsOf(model); j < model.pairs.size(); ++j) {
+                const Region& outer = regions.regions[regionOf(model.pairs[j])];
+                if (j == k || outer.area <= inner.area || outer.contour.empty() || !outer.bbox.contains(inner.contour.front()))
+                    continue;
+                if (cv::pointPolygonTest(outer.contour, probe, false) > 0) level[k] += 1.0;
+            }
+        }
+        return level;
+    };
+    const std::vector<double> levelA = nesting(model.regionsA, [](const PlacedPair& p) { return p.regionA; });
+    const std::vector<double> levelB = nesting(model.regionsB, [](const PlacedPair& p) { return p.regionB; });
+    std::vector<double> level(model.pairs.size());
+    for (std::size_t k = 0; k < level.size(); ++k) level[k] = (1.0 - t) * levelA[k] + t * levelB[k];
+    // Painter's order: the backdrop, then outer regions before the regions inside them (at each view exactly the
+    // drawing's own order), then far first; at equal depth the larger region first, so inner parts stay on top.
     const std::size_t backdrops = model.backdropPairs;
-    std::sort(items.begin(), items.end(), [backdrops](const Item& x, const Item& y) {
+    std::sort(items.begin(), items.end(), [backdrops, &level](const Item& x, const Item& y) {
         if ((x.pair < backdrops) != (y.pair < backdrops)) return x.pair < backdrops;
+        const double lx = std::round(level[x.pair]), ly = std::round(level[y.pair]);
+        if (lx != ly) return lx < ly;
         if (std::abs(x.depth - y.depth) > 1e-9) return x.depth < y.depth;
         return x.area > y.area;
     });
@@ -274,6 +301,42 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
     ToonModel model = buildToonModel(front.bgr, front.mask, a, side.bgr, side.mask, b, front.outline, side.outline, 20);
     model.guideA = frontGuide;
     model.guideB = sideGuide;
+    // The face parts are known in both views (the same landmarks placed them): a front part takes the side's part of
+    // its name as its match, where the similarity's pixel positions (different axes in the two views) would often
+    // pick the skin or the hair beside it.
+    auto regionAt = [](const Regions& regions, const std::vector<cv::Point2d>& polygon) -> std::optional<std::size_t> {
+        if (polygon.empty()) return std::nullopt;
+        cv::Point2d c(0, 0);
+        for (const auto& p : polygon) c += p;
+        c /= static_cast<double>(polygon.size());
+        const cv::Point q(cvRound(c.x), cvRound(c.y));
+        if (!cv::Rect(0, 0, regions.labels.cols, regions.labels.rows).contains(q)) return std::nullopt;
+        const int label = regions.labels.at<int>(q);
+        for (std::size_t i = 0; i < regions.regions.size(); ++i)
+            if (label > 0 && regions.regions[i].label == label) return i;
+        return std::nullopt;
+    };
+    for (const FeatureShape& fa : frontGuide.features) {
+        const auto ra = regionAt(model.regionsA, fa.polygon);
+        if (!ra) continue;
+        std::optional<std::size_t> rb;
+        for (const FeatureShape& fb : sideGuide.features)
+            if (fb.name == fa.name && (rb = regionAt(model.regionsB, fb.polygon))) break;
+        if (!rb) continue;
+        const Region& regionA = model.regionsA.regions[*ra];
+        const Region& regionB = model.regionsB.regions[*rb];
+        bool found = false;
+        for (std::size_t k = 0; k < model.pairs.size(); ++k)
+            if (model.pairs[k].regionA == *ra) {
+                model.pairs[k] = placePair(regionA, regionB, *ra, *rb, a, b);
+                model.contours[k] = correspondContours(regionA, regionB);
+                found = true;
+            }
+        if (!found) {
+            model.pairs.push_back(placePair(regionA, regionB, *ra, *rb, a, b));
+            model.contours.push_back(correspondContours(regionA, regionB));
+        }
+    }
     // The whole head as one more region per view, drawn behind the others: what stays unmatched leaves no hole.
     auto silhouette = [](const ToonDrawing& d, Regions& regions) {
         Region r;

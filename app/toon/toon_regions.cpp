@@ -439,7 +439,10 @@ ToonDrawing toonDrawing(const cv::Mat& photoBgr, const cv::Mat& headMask, int co
     cv::Mat index(photoBgr.size(), CV_8U, cv::Scalar(255));
     for (const cv::Point& p : inPixels) {
         const cv::Vec3b v = lab.at<cv::Vec3b>(p);
-        const bool skin = std::hypot(v[1] - skinRef[1], v[2] - skinRef[2]) <= kSkinChroma && v[0] >= skinRef[0] - kSkinDarker;
+        // Highlights wash the hue out towards grey: the lighter, the more chroma distance is allowed.
+        const float lighter = std::max(0.0f, v[0] - skinRef[0]);
+        const bool skin = std::hypot(v[1] - skinRef[1], v[2] - skinRef[2]) <= kSkinChroma * (1.0f + lighter / 40.0f) &&
+                          v[0] >= skinRef[0] - kSkinDarker;
         if (skin) {
             index.at<uchar>(p) = 0;
         } else {
