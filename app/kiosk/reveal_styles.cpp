@@ -79,7 +79,8 @@ public:
     void submit(std::uint64_t job, const StyleInputs& in) {
         {
             std::lock_guard lock(mutex_);
-            job_ = Job{job, in.front, in.frontMask, in.side, in.sideMask, in.sideNoseImageRight, in.sideChinRow};
+            job_ = Job{job, in.front, in.frontMask, in.side, in.sideMask, in.sideNoseImageRight, in.sideChinRow,
+                       toon::ToonLandmarks{in.frontLandmarks, in.sideLandmarks}};
         }
         wake_.notify_all();
     }
@@ -103,6 +104,7 @@ private:
         cv::Mat front, frontMask, side, sideMask;
         bool noseRight = true;
         int chinRow = -1;
+        toon::ToonLandmarks landmarks;
     };
     void run() {
         for (;;) {
@@ -126,7 +128,7 @@ private:
                     sideMask.rowRange(std::clamp(job.chinRow, 0, sideMask.rows), sideMask.rows).setTo(0);
                 }
                 r.model = std::make_shared<toon::ToonModel>(toon::toonFromPhotos(
-                    job.front, frontMask, job.side, sideMask, job.noseRight, settings_.toonColours));
+                    job.front, frontMask, job.side, sideMask, job.noseRight, settings_.toonColours, 320, job.landmarks));
             } catch (const std::exception& e) {
                 spdlog::warn("the toon could not be drawn: {}", e.what());
             }
@@ -168,6 +170,8 @@ StyleInputs styleInputsFrom(const FitOutcome& o) {
     in.side = o.side;
     in.sideMask = o.sideMask;
     in.sideNoseImageRight = o.sideNoseImageRight;
+    in.frontLandmarks = o.frontLandmarks.points;
+    in.sideLandmarks = o.sideLandmarks;
     if (const auto it = o.sideLandmarks.find("chin"); it != o.sideLandmarks.end())
         in.sideChinRow = static_cast<int>(it->second.y) + 1;
     return in;

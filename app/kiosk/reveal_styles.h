@@ -16,8 +16,10 @@
 
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <chrono>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -32,6 +34,9 @@ struct StyleInputs {
     cv::Mat front, frontMask, side, sideMask;
     bool sideNoseImageRight = true;
     int sideChinRow = -1;  // the side photo's chin row: both masks are cut there (head only); -1: not cut
+    // The fit's landmarks (optional): the toon draws the eyes, brows, nostrils and mouth as regions of their own.
+    std::optional<std::array<cv::Point2d, 68>> frontLandmarks;
+    std::map<std::string, cv::Point2d> sideLandmarks;
 };
 // Takes what the styles need from a fit (the photos and masks are shared, not copied).
 StyleInputs styleInputsFrom(const FitOutcome& outcome);

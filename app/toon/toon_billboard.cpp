@@ -13,6 +13,8 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <optional>
+#include <tuple>
 
 namespace avatarbooth::toon {
 
@@ -106,6 +108,8 @@ ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const Dr
 
 namespace {
 
+std::size_t backdropsOf(const ToonModel& model) { return std::min(model.backdropPairs, model.pairs.size()); }
+
 // Draws the billboards into `canvas` (CV_8UC3, its size is the render size) and, when `alpha` is not null, their
 // coverage into *alpha (CV_8U, cleared by the caller).
 void drawToon(const ToonModel& model, double yawDeg, cv::Mat& canvas, cv::Mat* alpha, double unitsPerPixel,
@@ -133,10 +137,34 @@ void drawToon(const ToonModel& model, double yawDeg, cv::Mat& canvas, cv::Mat* a
         const double area = (1.0 - t) * model.regionsA.regions[p.regionA].area + t * model.regionsB.regions[p.regionB].area;
         items.push_back({glm::dot(pos, towards), area, k, pos});
     }
-    // Painter's order: far first; at equal depth the larger region first, so inner parts stay on top.
+    // How deep each region sits inside others in its drawing (regions are drawn with their holes filled: a ring of
+    // hair round the face covers the face unless the face comes after it). Mixed between the views like the rest.
+    auto nesting = [&](const Regions& regions, auto regionOf) {
+        std::vector<double> level(model.pairs.size(), 0.0);
+        for (std::size_t k = backdropsOf(model); k < model.pairs.size(); ++k) {
+            const Region& inner = regions.regions[regionOf(model.pairs[k])];
+            if (inner.contour.empty()) continue;
+            const cv::Point2f probe = inner.contour.front();
+            for (std::size_t j = backdropsOf(model); j < model.pairs.size(); ++j) {
+                const Region& outer = regions.regions[regionOf(model.pairs[j])];
+                if (j == k || outer.area <= inner.area || outer.contour.empty() || !outer.bbox.contains(inner.contour.front()))
+                    continue;
+                if (cv::pointPolygonTest(outer.contour, probe, false) > 0) level[k] += 1.0;
+            }
+        }
+        return level;
+    };
+    const std::vector<double> levelA = nesting(model.regionsA, [](const PlacedPair& p) { return p.regionA; });
+    const std::vector<double> levelB = nesting(model.regionsB, [](const PlacedPair& p) { return p.regionB; });
+    std::vector<double> level(model.pairs.size());
+    for (std::size_t k = 0; k < level.size(); ++k) level[k] = (1.0 - t) * levelA[k] + t * levelB[k];
+    // Painter's order: the backdrop, then outer regions before the regions inside them (at each view exactly the
+    // drawing's own order), then far first; at equal depth the larger region first, so inner parts stay on top.
     const std::size_t backdrops = model.backdropPairs;
-    std::sort(items.begin(), items.end(), [backdrops](const Item& x, const Item& y) {
+    std::sort(items.begin(), items.end(), [backdrops, &level](const Item& x, const Item& y) {
         if ((x.pair < backdrops) != (y.pair < backdrops)) return x.pair < backdrops;
+        const double lx = std::round(level[x.pair]), ly = std::round(level[y.pair]);
+        if (lx != ly) return lx < ly;
         if (std::abs(x.depth - y.depth) > 1e-9) return x.depth < y.depth;
         return x.area > y.area;
     });
@@ -210,8 +238,11 @@ cv::Mat renderToonBgra(const ToonModel& model, double yawDeg, cv::Size size, dou
 }
 
 ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, const cv::Mat& sideBgr,
-                         const cv::Mat& sideMask, bool sideNoseImageRight, int colours, int headHeightPx) {
-    auto prepare = [&](const cv::Mat& bgr, const cv::Mat& mask, bool mirror, const char* which) {
+                         const cv::Mat& sideMask, bool sideNoseImageRight, int colours, int headHeightPx,
+                         const ToonLandmarks& landmarks) {
+    std::vector<cv::Vec3b> frontFeatureColours;
+    std::vector<std::string> frontFeatureNames;
+    auto prepare = [&](const cv::Mat& bgr, const cv::Mat& mask, bool mirror, const char* which, bool isFront) {
         if (bgr.empty() || mask.empty() || cv::countNonZero(mask > 127) == 0)
             throw BoothError(ErrorKind::NoFace, which, "no head mask to draw the toon from");
         const cv::Rect box = cv::boundingRect(mask > 127);
@@ -225,22 +256,87 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
             cv::flip(photo, photo, 1);
             cv::flip(m, m, 1);
         }
-        ToonDrawing drawing = toonDrawing(photo, m, colours);
+        // Photo pixels to drawing pixels: the crop, the scale (pixel centres), the mirror.
+        auto toDrawing = [&](cv::Point2d p) {
+            cv::Point2d q((p.x - padded.x + 0.5) * scale - 0.5, (p.y - padded.y + 0.5) * scale - 0.5);
+            if (mirror) q.x = photo.cols - 1 - q.x;
+            return q;
+        };
+        DrawingGuide guide;
+        if (isFront && landmarks.front) {
+            std::array<cv::Point2d, 68> points;
+            for (std::size_t i = 0; i < points.size(); ++i) points[i] = toDrawing((*landmarks.front)[i]);
+            guide = frontDrawingGuide(points);
+        } else if (!isFront && !landmarks.side.empty()) {
+            std::map<std::string, cv::Point2d> points;
+            for (const auto& [name, p] : landmarks.side) points[name] = toDrawing(p);
+            guide = sideDrawingGuide(points);
+            // The side's face parts in the front's colours: one person's eyes, brows and lips, and the regions match.
+            for (FeatureShape& f : guide.features)
+                for (std::size_t i = 0; i < frontFeatureNames.size(); ++i)
+                    if (frontFeatureNames[i] == f.name) {
+                        f.colour = frontFeatureColours[i];
+                        break;
+                    }
+        }
+        ToonDrawing drawing = toonDrawing(photo, m, colours, 2, guide);
+        if (isFront)
+            for (std::size_t i = 0; i < guide.features.size(); ++i) {
+                frontFeatureNames.push_back(guide.features[i].name);
+                frontFeatureColours.push_back(drawing.featureColours[i]);
+            }
         const cv::Rect b2 = cv::boundingRect(drawing.mask);
-        return std::pair{drawing, cv::Point2d(b2.x + (b2.width - 1) / 2.0, b2.y + (b2.height - 1) / 2.0)};
+        return std::tuple{drawing, cv::Point2d(b2.x + (b2.width - 1) / 2.0, b2.y + (b2.height - 1) / 2.0), guide};
     };
-    auto [front, frontCentre] = prepare(frontBgr, frontMask, false, "front photo");
+    auto [front, frontCentre, frontGuide] = prepare(frontBgr, frontMask, false, "front photo", true);
     // Theta 90 looks from +x (the character's left): the face points to image left, so a nose-right photo flips.
-    auto [side, sideCentre] = prepare(sideBgr, sideMask, sideNoseImageRight, "side photo");
+    auto [side, sideCentre, sideGuide] = prepare(sideBgr, sideMask, sideNoseImageRight, "side photo", false);
     DrawingView a, b;
     a.direction = {0.0, 0.0};
     a.centre = frontCentre;
     b.direction = {90.0, 0.0};
     b.centre = sideCentre;
-    // Photos give many small shading patches that no view shares: keep regions of at least 1/400 of the head's
-    // height squared (a 16 px square at 320 px), the size of an eye's parts.
-    ToonModel model = buildToonModel(front.bgr, front.mask, a, side.bgr, side.mask, b, front.outline, side.outline,
-                                     std::max(30, headHeightPx * headHeightPx / 400));
+    // The drawing already joined shading patches under 1/400 of the head's height squared to their neighbours; what
+    // is smaller now is a face part painted from the landmarks (an iris, a nostril), kept down to 20 pixels.
+    ToonModel model = buildToonModel(front.bgr, front.mask, a, side.bgr, side.mask, b, front.outline, side.outline, 20);
+    model.guideA = frontGuide;
+    model.guideB = sideGuide;
+    // The face parts are known in both views (the same landmarks placed them): a front part takes the side's part of
+    // its name as its match, where the similarity's pixel positions (different axes in the two views) would often
+    // pick the skin or the hair beside it.
+    auto regionAt = [](const Regions& regions, const std::vector<cv::Point2d>& polygon) -> std::optional<std::size_t> {
+        if (polygon.empty()) return std::nullopt;
+        cv::Point2d c(0, 0);
+        for (const auto& p : polygon) c += p;
+        c /= static_cast<double>(polygon.size());
+        const cv::Point q(cvRound(c.x), cvRound(c.y));
+        if (!cv::Rect(0, 0, regions.labels.cols, regions.labels.rows).contains(q)) return std::nullopt;
+        const int label = regions.labels.at<int>(q);
+        for (std::size_t i = 0; i < regions.regions.size(); ++i)
+            if (label > 0 && regions.regions[i].label == label) return i;
+        return std::nullopt;
+    };
+    for (const FeatureShape& fa : frontGuide.features) {
+        const auto ra = regionAt(model.regionsA, fa.polygon);
+        if (!ra) continue;
+        std::optional<std::size_t> rb;
+        for (const FeatureShape& fb : sideGuide.features)
+            if (fb.name == fa.name && (rb = regionAt(model.regionsB, fb.polygon))) break;
+        if (!rb) continue;
+        const Region& regionA = model.regionsA.regions[*ra];
+        const Region& regionB = model.regionsB.regions[*rb];
+        bool found = false;
+        for (std::size_t k = 0; k < model.pairs.size(); ++k)
+            if (model.pairs[k].regionA == *ra) {
+                model.pairs[k] = placePair(regionA, regionB, *ra, *rb, a, b);
+                model.contours[k] = correspondContours(regionA, regionB);
+                found = true;
+            }
+        if (!found) {
+            model.pairs.push_back(placePair(regionA, regionB, *ra, *rb, a, b));
+            model.contours.push_back(correspondContours(regionA, regionB));
+        }
+    }
     // The whole head as one more region per view, drawn behind the others: what stays unmatched leaves no hole.
     auto silhouette = [](const ToonDrawing& d, Regions& regions) {
         Region r;
@@ -266,14 +362,18 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
     model.backdropPairs = 1;
     return model;
 }
-ToonModel toonFromPhotoPair(const cv::Mat& frontBgr, const cv::Mat& sideBgr, const cv::Mat& plate, int colours) {
+ToonModel toonFromPhotoPair(const cv::Mat& frontBgr, const cv::Mat& sideBgr, const cv::Mat& plate, int colours,
+                            const std::optional<std::array<cv::Point2d, 68>>& frontLandmarks) {
     const SideAnalysis profile = analyzeSidePhoto(sideBgr, plate);
     // Both photos come from the same camera at the same height: the side photo's chin row cuts both masks to the head.
     const int chin = static_cast<int>(profilePoint(profile.landmarks, "chin").y) + 1;
     cv::Mat frontMask = segmentPerson(frontBgr, plate), sideMask = profile.mask.clone();
     frontMask.rowRange(std::clamp(chin, 0, frontMask.rows), frontMask.rows).setTo(0);
     sideMask.rowRange(std::clamp(chin, 0, sideMask.rows), sideMask.rows).setTo(0);
-    return toonFromPhotos(frontBgr, frontMask, sideBgr, sideMask, profile.noseImageRight, colours);
+    ToonLandmarks landmarks;
+    landmarks.front = frontLandmarks;
+    for (const ProfilePoint& p : profile.landmarks) landmarks.side[p.name] = p.px;
+    return toonFromPhotos(frontBgr, frontMask, sideBgr, sideMask, profile.noseImageRight, colours, 320, landmarks);
 }
 
 std::vector<std::pair<std::string, std::string>> turntableFrames(const ToonModel& model, int frames, cv::Size size,

@@ -28,6 +28,8 @@ struct ToonModel {
     // The first `backdropPairs` pairs are drawn first whatever their depth (toonFromPhotos: the whole head's
     // silhouette, so regions left unmatched leave no holes).
     std::size_t backdropPairs = 0;
+    // The face parts the drawings were guided by (toonFromPhotos with landmarks), in each drawing's pixels.
+    DrawingGuide guideA, guideB;
 };
 // Splits both drawings (regions under `minRegionArea` pixels join their neighbours), matches A's regions to B's, places every matched pair and corresponds its outlines.
 ToonModel buildToonModel(const cv::Mat& drawingA, const cv::Mat& maskA, const DrawingView& viewA,
@@ -56,16 +58,25 @@ cv::Mat renderToonBgra(const ToonModel& model, double yawDeg, cv::Size size, dou
 // the character's left side (theta 90). Both are cropped to their masks and scaled to `headHeightPx` pixels of
 // mask height, so heights agree; the origin is the front mask's box centre and the side mask's box centre.
 // Throws BoothError(NoFace) when a mask is empty.
+// `landmarks` (optional) guide the drawings: the face parts become regions of their own in both views
+// (frontDrawingGuide, sideDrawingGuide; the side's parts take the front's colours, so they match) and the skin's
+// colour is taken from the cheeks.
+struct ToonLandmarks {
+    std::optional<std::array<cv::Point2d, 68>> front;  // dlib's 68 points, front photo pixels
+    std::map<std::string, cv::Point2d> side;           // profile points (kProfileLandmarkNames), side photo pixels
+};
 ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, const cv::Mat& sideBgr,
                          const cv::Mat& sideMask, bool sideNoseImageRight, int colours = 6,
-                         int headHeightPx = 320);
+                         int headHeightPx = 320, const ToonLandmarks& landmarks = {});
 
 // The whole recipe from two photos (what `avatarbooth toon` and the kiosk use): the person's silhouette in each photo
 // (segmentPerson; the side one from analyzeSidePhoto, which also says which way it faces), both cut at the side
 // photo's chin row (same camera, same height) so the masks hold the head, then toonFromPhotos. `plate` (the empty
 // booth, optional) improves the silhouettes. Throws BoothError(NoFace) when the side profile or a mask is missing.
+// `frontLandmarks` (dlib's 68 points of the front photo, optional) guide the drawing with the side's profile points.
 ToonModel toonFromPhotoPair(const cv::Mat& frontBgr, const cv::Mat& sideBgr, const cv::Mat& plate = cv::Mat(),
-                            int colours = 6);
+                            int colours = 6,
+                            const std::optional<std::array<cv::Point2d, 68>>& frontLandmarks = std::nullopt);
 
 
 // The turntable strip in memory: `frames` (file name, PNG bytes) sweeping the yaw from -90 to 90 degrees.

@@ -253,94 +253,315 @@ void mergeSmallPatches(cv::Mat& index, const cv::Mat& centres, int minArea) {
 
 }  // namespace
 
-ToonDrawing toonDrawing(const cv::Mat& photoBgr, const cv::Mat& headMask, int colours, int outlineWidth) {
+namespace {
+
+std::vector<cv::Point2d> ellipsePolygon(cv::Point2d centre, double rx, double ry, int n = 16) {
+    std::vector<cv::Point2d> out;
+    for (int i = 0; i < n; ++i) {
+        const double a = 2.0 * std::numbers::pi * i / n;
+        out.emplace_back(centre.x + rx * std::cos(a), centre.y + ry * std::sin(a));
+    }
+    return out;
+}
+
+cv::Point2d meanOf(const std::array<cv::Point2d, 68>& p, int from, int to) {
+    cv::Point2d sum(0, 0);
+    for (int i = from; i <= to; ++i) sum += p[static_cast<std::size_t>(i)];
+    return sum / static_cast<double>(to - from + 1);
+}
+
+// The polygon scaled about its centre (sx across, sy down), at least `minHeight` high.
+std::vector<cv::Point2d> scaled(std::vector<cv::Point2d> poly, double s, double minHeight = 0.0) {
+    cv::Point2d c(0, 0);
+    double top = 1e18, bottom = -1e18;
+    for (const auto& q : poly) {
+        c += q;
+        top = std::min(top, q.y);
+        bottom = std::max(bottom, q.y);
+    }
+    c /= static_cast<double>(poly.size());
+    const double sy = std::max(s, bottom > top ? minHeight / (bottom - top) : s);
+    for (auto& q : poly) q = {c.x + (q.x - c.x) * s, c.y + (q.y - c.y) * sy};
+    return poly;
+}
+
+// The part of `shape` inside the convex `within` (an iris inside its eye).
+std::vector<cv::Point2d> clippedTo(const std::vector<cv::Point2d>& shape, const std::vector<cv::Point2d>& within) {
+    std::vector<cv::Point2f> a(shape.begin(), shape.end()), b, hull, out;
+    for (const auto& q : within) b.emplace_back(q);
+    cv::convexHull(b, hull);
+    cv::intersectConvexConvex(a, hull, out, true);
+    return {out.begin(), out.end()};
+}
+
+}  // namespace
+
+DrawingGuide frontDrawingGuide(const std::array<cv::Point2d, 68>& p) {
+    DrawingGuide g;
+    const cv::Point2d eyeR = meanOf(p, 36, 41), eyeL = meanOf(p, 42, 47);
+    const double d = cv::norm(eyeL - eyeR);  // the eyes' distance: the face's own unit
+    if (!(d > 1.0)) return g;
+    using Tone = FeatureShape::Tone;
+    // Brows: dlib's points run along the brow's middle; a band 0.13 d thick, its ends tapered.
+    for (int from : {17, 22}) {
+        std::vector<cv::Point2d> poly;
+        for (int i = from; i < from + 5; ++i) {
+            const double taper = (i == from || i == from + 4) ? 0.5 : 1.0;
+            poly.push_back(p[static_cast<std::size_t>(i)] + cv::Point2d(0, -0.05 * d * taper));
+        }
+        for (int i = from + 4; i >= from; --i) {
+            const double taper = (i == from || i == from + 4) ? 0.5 : 1.0;
+            poly.push_back(p[static_cast<std::size_t>(i)] + cv::Point2d(0, 0.08 * d * taper));
+        }
+        g.features.push_back({"brow", poly, Tone::Dark, {}});
+    }
+    // Eyes a little larger and opener than the photo's (a drawing's eyes read at a glance), the iris inside.
+    for (int from : {36, 42}) {
+        std::vector<cv::Point2d> eye(p.begin() + from, p.begin() + from + 6);
+        eye = scaled(eye, 1.2, 0.2 * d);
+        const cv::Point2d c = meanOf(p, from, from + 5);
+        g.features.push_back({"eye", eye, Tone::Light, {}});
+        g.features.push_back({"iris", clippedTo(ellipsePolygon(c, 0.11 * d, 0.11 * d), eye), Tone::Dark, {}});
+    }
+    // Nostrils: beside the nose's base (31 .. 35), just above it.
+    const double nostrilY = -0.04 * d;
+    g.features.push_back({"nostril", ellipsePolygon((p[31] + p[32]) * 0.5 + cv::Point2d(0, nostrilY), 0.06 * d, 0.035 * d), Tone::Dark, {}});
+    g.features.push_back({"nostril", ellipsePolygon((p[34] + p[35]) * 0.5 + cv::Point2d(0, nostrilY), 0.06 * d, 0.035 * d), Tone::Dark, {}});
+    // Lips: the outer lip line, at least 0.16 d high (closed lips are thin).
+    g.features.push_back({"mouth", scaled({p.begin() + 48, p.begin() + 60}, 1.05, 0.16 * d), Tone::Middle, {}});
+    // Bare skin: the cheeks between the jaw, the mouth's corner and the nose.
+    g.skinSamples.push_back({p[1], p[3], p[48], p[31]});
+    g.skinSamples.push_back({p[15], p[13], p[54], p[35]});
+    return g;
+}
+
+DrawingGuide sideDrawingGuide(const std::map<std::string, cv::Point2d>& profile) {
+    DrawingGuide g;
+    auto at = [&](const char* name) -> std::optional<cv::Point2d> {
+        const auto it = profile.find(name);
+        if (it == profile.end()) return std::nullopt;
+        return it->second;
+    };
+    const auto nasion = at("nasion"), sub = at("subnasale"), tip = at("nose_tip"), upper = at("upper_lip"),
+               lower = at("lower_lip"), glabella = at("glabella"), ear = at("ear_hole");
+    if (!nasion || !sub || !tip || !upper || !lower || !glabella) return g;
+    const double h = sub->y - nasion->y;  // nasion to subnasale, about 50 mm on an adult
+    if (!(h > 1.0)) return g;
+    using Tone = FeatureShape::Tone;
+    // The face points to -x: "back" is +x. Fractions of h from average adult proportions (the cornea about 10 mm
+    // behind the nasion and 10 mm below it, the visible eye about 20 mm long in profile, the brow 15 mm above the
+    // eye, the mouth's corner 25 mm behind the lips).
+    const cv::Point2d eyeFront(nasion->x + 0.22 * h, nasion->y + 0.22 * h);
+    const std::vector<cv::Point2d> eye{eyeFront, {eyeFront.x + 0.2 * h, eyeFront.y - 0.12 * h},
+                                       {eyeFront.x + 0.42 * h, eyeFront.y - 0.02 * h},
+                                       {eyeFront.x + 0.18 * h, eyeFront.y + 0.1 * h}};
+    g.features.push_back({"eye", eye, Tone::Light, {}});
+    g.features.push_back({"iris", clippedTo(ellipsePolygon({eyeFront.x + 0.1 * h, eyeFront.y - 0.01 * h}, 0.07 * h, 0.12 * h), eye),
+                          Tone::Dark, {}});
+    const double browY = eyeFront.y - 0.32 * h;
+    const double browX = glabella->x + 0.12 * h;
+    g.features.push_back({"brow",
+                          {{browX, browY - 0.04 * h}, {browX + 0.3 * h, browY - 0.08 * h}, {browX + 0.62 * h, browY - 0.02 * h},
+                           {browX + 0.6 * h, browY + 0.05 * h}, {browX + 0.3 * h, browY + 0.02 * h}, {browX, browY + 0.06 * h}},
+                          Tone::Dark, {}});
+    g.features.push_back({"nostril", ellipsePolygon({tip->x + 0.3 * h, sub->y - 0.07 * h}, 0.1 * h, 0.05 * h), Tone::Dark, {}});
+    const double lipFront = std::max(upper->x, lower->x) + 0.03 * h, mouthY = (upper->y + lower->y) / 2.0;
+    g.features.push_back({"mouth",
+                          {{upper->x + 0.03 * h, upper->y - 0.1 * h}, {lipFront + 0.45 * h, mouthY - 0.03 * h},
+                           {lipFront + 0.45 * h, mouthY + 0.03 * h}, {lower->x + 0.03 * h, lower->y + 0.1 * h},
+                           {std::min(upper->x, lower->x) + 0.02 * h, mouthY}},
+                          Tone::Middle, {}});
+    // Bare skin: the cheek, between the nose and the ear at the nose's height.
+    const cv::Point2d cheek = ear ? cv::Point2d((tip->x + 2.0 * ear->x) / 3.0, tip->y) : cv::Point2d(tip->x + 0.9 * h, tip->y);
+    g.skinSamples.push_back(ellipsePolygon(cheek, 0.25 * h, 0.25 * h));
+    return g;
+}
+
+ToonDrawing toonDrawing(const cv::Mat& photoBgr, const cv::Mat& headMask, int colours, int outlineWidth,
+                        const DrawingGuide& guide) {
     CV_Assert(photoBgr.type() == CV_8UC3 && headMask.size() == photoBgr.size());
     ToonDrawing out;
     out.mask = headMask > 127;
     out.bgr = cv::Mat(photoBgr.size(), CV_8UC3, cv::Scalar(255, 255, 255));
     out.outline = cv::Mat(photoBgr.size(), CV_8U, cv::Scalar(0));
+    out.featureColours.assign(guide.features.size(), cv::Vec3b(0, 0, 0));
     std::vector<cv::Point> inPixels;
     cv::findNonZero(out.mask, inPixels);
+    colours = std::clamp(colours, 2, 16);
     if (static_cast<int>(inPixels.size()) < colours) return out;
     // Sizes follow the head: the mask's height (photos come scaled to ~320 px of head, but any size works).
     const cv::Rect head = cv::boundingRect(out.mask);
     const double unit = head.height / 320.0;
     // Mean shift flattens skin shading and pores into patches while keeping the edges of eyes, brows and hair; a
-    // bilateral pass then evens what is left. (Bilateral alone left shading bands that k-means cut into many patches.)
+    // bilateral pass then evens what is left.
     cv::Mat smooth, shifted;
     cv::pyrMeanShiftFiltering(photoBgr, shifted, std::max(4.0, 8.0 * unit), 20.0, 1);
     cv::bilateralFilter(shifted, smooth, 7, 30.0, 5.0);
-    // k-means in Lab with the lightness weighted down: shading changes lightness much more than hue, so the skin stays
-    // one cluster under the booth's side light while hair, eyes, lips and brows (different chroma or much darker)
-    // keep theirs.
     cv::Mat lab;
     cv::cvtColor(smooth, lab, cv::COLOR_BGR2Lab);
-    constexpr float kLightnessWeight = 0.5f;
-    cv::Mat samples(static_cast<int>(inPixels.size()), 3, CV_32F);
-    for (int i = 0; i < samples.rows; ++i) {
-        const cv::Vec3b p = lab.at<cv::Vec3b>(inPixels[static_cast<std::size_t>(i)]);
-        samples.at<float>(i, 0) = p[0] * kLightnessWeight;
-        samples.at<float>(i, 1) = p[1];
-        samples.at<float>(i, 2) = p[2];
+
+    // The skin's colour: the median Lab of the guide's bare-skin areas, else of the middle of the head.
+    cv::Mat skinArea(photoBgr.size(), CV_8U, cv::Scalar(0));
+    for (const auto& poly : guide.skinSamples) {
+        std::vector<cv::Point> q;
+        for (const auto& p : poly) q.emplace_back(cvRound(p.x), cvRound(p.y));
+        if (q.size() >= 3) cv::fillPoly(skinArea, std::vector<std::vector<cv::Point>>{q}, cv::Scalar(255));
     }
-    cv::Mat clusterOf, centres;
-    cv::setRNGSeed(7);  // the same photo gives the same drawing
-    cv::kmeans(samples, colours, clusterOf, cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 1.0),
-               3, cv::KMEANS_PP_CENTERS, centres);
-    // Clusters that differ in lightness only (the same material lit differently: skin in light and in shade, hair
-    // with its sheen) become one: chroma (a, b) within kSameChroma and raw lightness within kSameLightness. Lips,
-    // eyes and hair differ in chroma or by much more lightness and stay apart. k-means alone cuts the skin, the
-    // largest area, into bands whatever the weights.
-    constexpr double kSameChroma = 6.0, kSameLightness = 40.0;
-    std::vector<int> merged(static_cast<std::size_t>(colours));
-    for (int k = 0; k < colours; ++k) merged[static_cast<std::size_t>(k)] = k;
-    std::vector<int> clusterSize(static_cast<std::size_t>(colours), 0);
-    for (int i = 0; i < samples.rows; ++i) ++clusterSize[static_cast<std::size_t>(clusterOf.at<int>(i))];
-    for (int a = 0; a < colours; ++a)
-        for (int b = a + 1; b < colours; ++b) {
-            const double dl = std::abs(centres.at<float>(a, 0) - centres.at<float>(b, 0)) / kLightnessWeight;
-            const double dc = std::hypot(centres.at<float>(a, 1) - centres.at<float>(b, 1),
-                                         centres.at<float>(a, 2) - centres.at<float>(b, 2));
-            if (dl > kSameLightness || dc > kSameChroma) continue;
-            const int ra = merged[static_cast<std::size_t>(a)], rb = merged[static_cast<std::size_t>(b)];
-            if (ra == rb) continue;
-            for (int& m : merged)
-                if (m == rb) m = ra;
-        }
+    skinArea &= out.mask;
+    if (cv::countNonZero(skinArea) < 30) {
+        skinArea.setTo(0);
+        const cv::Rect middle(head.x + head.width * 35 / 100, head.y + head.height * 45 / 100, std::max(1, head.width * 3 / 10),
+                              std::max(1, head.height / 4));
+        skinArea(middle & cv::Rect(0, 0, skinArea.cols, skinArea.rows)).setTo(255);
+        skinArea &= out.mask;
+    }
+    cv::Vec3f skinRef(0, 0, 0);
     {
-        // Merged centres: the size-weighted mean of their members.
-        cv::Mat joined(centres.size(), centres.type(), cv::Scalar(0));
-        std::vector<double> weight(static_cast<std::size_t>(colours), 0.0);
-        for (int k = 0; k < colours; ++k) {
-            const int m = merged[static_cast<std::size_t>(k)];
-            cv::Mat into = joined.row(m);
-            into += centres.row(k) * clusterSize[static_cast<std::size_t>(k)];
-            weight[static_cast<std::size_t>(m)] += clusterSize[static_cast<std::size_t>(k)];
-        }
-        for (int k = 0; k < colours; ++k)
-            if (weight[static_cast<std::size_t>(k)] > 0) {
-                cv::Mat row = joined.row(k);
-                row /= weight[static_cast<std::size_t>(k)];
+        std::vector<float> ch[3];
+        for (int r = 0; r < lab.rows; ++r)
+            for (int c = 0; c < lab.cols; ++c)
+                if (skinArea.at<uchar>(r, c)) {
+                    const cv::Vec3b v = lab.at<cv::Vec3b>(r, c);
+                    for (int k = 0; k < 3; ++k) ch[k].push_back(v[k]);
+                }
+        for (int k = 0; k < 3; ++k)
+            if (!ch[k].empty()) {
+                std::nth_element(ch[k].begin(), ch[k].begin() + static_cast<std::ptrdiff_t>(ch[k].size() / 2), ch[k].end());
+                skinRef[k] = ch[k][ch[k].size() / 2];
             }
-        centres = joined;
     }
+    // Skin: the skin's hue (a, b within kSkinChroma) at any lightness from kSkinDarker below it to anything above:
+    // light and shade on one face change lightness far more than hue, and hair, lips and eyes differ in hue or are
+    // much darker. (OpenCV's 8-bit Lab: L scaled to 0..255, a and b offset by 128.)
+    constexpr float kSkinChroma = 14.0f, kSkinDarker = 75.0f;
+    constexpr float kLightnessWeight = 0.5f;
+    std::vector<cv::Point> otherPixels;
     cv::Mat index(photoBgr.size(), CV_8U, cv::Scalar(255));
-    std::vector<cv::Vec3d> sum(static_cast<std::size_t>(colours), cv::Vec3d(0, 0, 0));
-    std::vector<double> n(static_cast<std::size_t>(colours), 0.0);
-    for (int i = 0; i < samples.rows; ++i) {
-        const int k = merged[static_cast<std::size_t>(clusterOf.at<int>(i))];
-        const cv::Point p = inPixels[static_cast<std::size_t>(i)];
-        index.at<uchar>(p) = static_cast<uchar>(k);
-        const cv::Vec3b bgr = smooth.at<cv::Vec3b>(p);
-        sum[static_cast<std::size_t>(k)] += cv::Vec3d(bgr[0], bgr[1], bgr[2]);
-        n[static_cast<std::size_t>(k)] += 1.0;
+    for (const cv::Point& p : inPixels) {
+        const cv::Vec3b v = lab.at<cv::Vec3b>(p);
+        // Highlights wash the hue out towards grey: the lighter, the more chroma distance is allowed.
+        const float lighter = std::max(0.0f, v[0] - skinRef[0]);
+        const bool skin = std::hypot(v[1] - skinRef[1], v[2] - skinRef[2]) <= kSkinChroma * (1.0f + lighter / 40.0f) &&
+                          v[0] >= skinRef[0] - kSkinDarker;
+        if (skin) {
+            index.at<uchar>(p) = 0;
+        } else {
+            otherPixels.push_back(p);
+        }
     }
-    cv::medianBlur(index, index, 5);  // removes single-pixel islands between clusters
-    index.setTo(255, ~out.mask);
-    // Patches under 1/400 of the head height squared (a 16 px square at 320 px: an eye's parts) go to the touching
-    // patch of the nearest colour, so every region left is a face part, not a shading fleck.
+    // The rest: k-means in Lab with the lightness weighted down, clusters differing in lightness only merged (hair
+    // with its sheen).
+    const int others = std::min(colours - 1, static_cast<int>(otherPixels.size()));
+    cv::Mat centres(1 + std::max(others, 0), 3, CV_32F, cv::Scalar(0));
+    centres.at<float>(0, 0) = skinRef[0] * kLightnessWeight;
+    centres.at<float>(0, 1) = skinRef[1];
+    centres.at<float>(0, 2) = skinRef[2];
+    if (others >= 1) {
+        cv::Mat samples(static_cast<int>(otherPixels.size()), 3, CV_32F);
+        for (int i = 0; i < samples.rows; ++i) {
+            const cv::Vec3b p = lab.at<cv::Vec3b>(otherPixels[static_cast<std::size_t>(i)]);
+            samples.at<float>(i, 0) = p[0] * kLightnessWeight;
+            samples.at<float>(i, 1) = p[1];
+            samples.at<float>(i, 2) = p[2];
+        }
+        cv::Mat clusterOf, otherCentres;
+        cv::setRNGSeed(7);  // the same photo gives the same drawing
+        cv::kmeans(samples, others, clusterOf, cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 20, 1.0),
+                   2, cv::KMEANS_PP_CENTERS, otherCentres);
+        constexpr double kSameChroma = 6.0, kSameLightness = 40.0;
+        std::vector<int> merged(static_cast<std::size_t>(others));
+        for (int k = 0; k < others; ++k) merged[static_cast<std::size_t>(k)] = k;
+        for (int a = 0; a < others; ++a)
+            for (int b = a + 1; b < others; ++b) {
+                const double dl = std::abs(otherCentres.at<float>(a, 0) - otherCentres.at<float>(b, 0)) / kLightnessWeight;
+                const double dc = std::hypot(otherCentres.at<float>(a, 1) - otherCentres.at<float>(b, 1),
+                                             otherCentres.at<float>(a, 2) - otherCentres.at<float>(b, 2));
+                if (dl > kSameLightness || dc > kSameChroma) continue;
+                const int ra = merged[static_cast<std::size_t>(a)], rb = merged[static_cast<std::size_t>(b)];
+                for (int& m : merged)
+                    if (m == rb) m = ra;
+            }
+        for (int k = 0; k < others; ++k) otherCentres.row(merged[static_cast<std::size_t>(k)]).copyTo(centres.row(1 + merged[static_cast<std::size_t>(k)]));
+        for (int i = 0; i < samples.rows; ++i)
+            index.at<uchar>(otherPixels[static_cast<std::size_t>(i)]) =
+                static_cast<uchar>(1 + merged[static_cast<std::size_t>(clusterOf.at<int>(i))]);
+    }
+    // Majority filter: each pixel takes the label most common around it, which smooths the regions' boundaries and
+    // removes thin shading streaks (a median of label numbers would invent labels between them).
+    {
+        const int radius = std::max(2, cvRound(4.0 * unit));
+        const int labels = centres.rows;
+        cv::Mat best(index.size(), CV_32F, cv::Scalar(-1.0f)), chosen = index.clone();
+        for (int k = 0; k < labels; ++k) {
+            cv::Mat votes;
+            cv::Mat(index == k).convertTo(votes, CV_32F, 1.0 / 255.0);
+            cv::blur(votes, votes, cv::Size(2 * radius + 1, 2 * radius + 1));
+            cv::Mat better = votes > best;
+            votes.copyTo(best, better);
+            chosen.setTo(k, better);
+        }
+        index = chosen;
+        index.setTo(255, ~out.mask);
+    }
+    // Patches under 1/400 of the head height squared (a 16 px square at 320 px) go to the touching patch of the
+    // nearest colour, so every region left is a part of the head, not a shading fleck.
     mergeSmallPatches(index, centres, std::max(30, cvRound(head.height * head.height / 400.0)));
-    // Edges: where the patch colour changes, and the head's own boundary.
+
+    // Colours: each label's mean photo colour (smoothed); the skin's from the skin pixels.
+    std::vector<cv::Vec3d> sum(256, cv::Vec3d(0, 0, 0));
+    std::vector<double> n(256, 0.0);
+    for (const cv::Point& p : inPixels) {
+        const uchar k = index.at<uchar>(p);
+        if (k == 255) continue;
+        const cv::Vec3b bgr = smooth.at<cv::Vec3b>(p);
+        sum[k] += cv::Vec3d(bgr[0], bgr[1], bgr[2]);
+        n[k] += 1.0;
+    }
+    std::vector<cv::Vec3b> colourOf(256, cv::Vec3b(0, 0, 0));
+    for (int k = 0; k < 255; ++k) {
+        const cv::Vec3d m = sum[static_cast<std::size_t>(k)] / std::max(1.0, n[static_cast<std::size_t>(k)]);
+        colourOf[static_cast<std::size_t>(k)] = cv::Vec3b(cv::saturate_cast<uchar>(m[0]), cv::saturate_cast<uchar>(m[1]),
+                                                          cv::saturate_cast<uchar>(m[2]));
+    }
+    out.skinColour = colourOf[0];
+
+    // The face parts, painted over in order (an iris after its eye), each a label of its own with its own colour.
+    int nextLabel = centres.rows;
+    for (std::size_t f = 0; f < guide.features.size() && nextLabel < 255; ++f) {
+        const FeatureShape& shape = guide.features[f];
+        std::vector<cv::Point> q;
+        for (const auto& p : shape.polygon) q.emplace_back(cvRound(p.x), cvRound(p.y));
+        if (q.size() < 3) continue;
+        cv::Mat area(photoBgr.size(), CV_8U, cv::Scalar(0));
+        cv::fillPoly(area, std::vector<std::vector<cv::Point>>{q}, cv::Scalar(255));
+        area &= out.mask;
+        std::vector<cv::Point> pixels;
+        cv::findNonZero(area, pixels);
+        if (pixels.empty()) continue;
+        cv::Vec3b colour;
+        if (shape.colour) {
+            colour = *shape.colour;
+        } else {
+            // The photo's own pixels under it, by lightness: the darker third, the lighter third or the middle half.
+            std::vector<std::pair<int, cv::Vec3b>> byLight;
+            for (const cv::Point& p : pixels) byLight.emplace_back(lab.at<cv::Vec3b>(p)[0], smooth.at<cv::Vec3b>(p));
+            std::sort(byLight.begin(), byLight.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+            const std::size_t m = byLight.size();
+            std::size_t from = m / 4, to = m - m / 4;
+            if (shape.tone == FeatureShape::Tone::Dark) from = 0, to = std::max<std::size_t>(1, m / 3);
+            if (shape.tone == FeatureShape::Tone::Light) from = m - std::max<std::size_t>(1, m / 3), to = m;
+            cv::Vec3d s(0, 0, 0);
+            for (std::size_t i = from; i < to; ++i) s += cv::Vec3d(byLight[i].second[0], byLight[i].second[1], byLight[i].second[2]);
+            s /= static_cast<double>(std::max<std::size_t>(1, to - from));
+            colour = cv::Vec3b(cv::saturate_cast<uchar>(s[0]), cv::saturate_cast<uchar>(s[1]), cv::saturate_cast<uchar>(s[2]));
+        }
+        out.featureColours[f] = colour;
+        colourOf[static_cast<std::size_t>(nextLabel)] = colour;
+        index.setTo(nextLabel, area);
+        ++nextLabel;
+    }
+
+    // Edges: where the label changes, and the head's own boundary.
     cv::Mat edges(photoBgr.size(), CV_8U, cv::Scalar(0));
     for (int r = 0; r + 1 < index.rows; ++r)
         for (int c = 0; c + 1 < index.cols; ++c) {
@@ -351,19 +572,14 @@ ToonDrawing toonDrawing(const cv::Mat& photoBgr, const cv::Mat& headMask, int co
         cv::dilate(edges, edges, cv::getStructuringElement(cv::MORPH_ELLIPSE, {outlineWidth, outlineWidth}));
     }
     out.outline = edges & out.mask;
-    for (int r = 0; r < index.rows; ++r)
-        for (int c = 0; c < index.cols; ++c) {
-            const uchar k = index.at<uchar>(r, c);
-            if (!out.mask.at<uchar>(r, c)) continue;
-            if (out.outline.at<uchar>(r, c)) {
-                out.bgr.at<cv::Vec3b>(r, c) = cv::Vec3b(0, 0, 0);
-            } else if (k != 255) {
-                // The cluster's mean photo colour (the Lab centre is weighted, so it is not a colour to show).
-                const cv::Vec3d m = sum[k] / std::max(1.0, n[k]);
-                out.bgr.at<cv::Vec3b>(r, c) = cv::Vec3b(cv::saturate_cast<uchar>(m[0]), cv::saturate_cast<uchar>(m[1]),
-                                                        cv::saturate_cast<uchar>(m[2]));
-            }
+    for (const cv::Point& p : inPixels) {
+        const uchar k = index.at<uchar>(p);
+        if (out.outline.at<uchar>(p)) {
+            out.bgr.at<cv::Vec3b>(p) = cv::Vec3b(0, 0, 0);
+        } else if (k != 255) {
+            out.bgr.at<cv::Vec3b>(p) = colourOf[k];
         }
+    }
     return out;
 }
 

@@ -4,7 +4,10 @@
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>
 
+#include <array>
+#include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace avatarbooth::toon {
@@ -61,15 +64,46 @@ struct Regions {
 Regions splitRegions(const cv::Mat& drawingBgr, const cv::Mat& mask = cv::Mat(), const cv::Mat& outline = cv::Mat(),
                      int outlineMaxGrey = 60, int minArea = 30);
 
+// A face part drawn as its own flat region wherever the photo's colours put it (eyes and mouth vanish into the skin
+// otherwise): an outline placed from landmarks, in the drawing's pixels.
+struct FeatureShape {
+    std::string name;                  // "eye", "iris", "brow", "mouth", "nostril"
+    std::vector<cv::Point2d> polygon;  // closed outline
+    // Which of the photo's pixels under the polygon give its colour: the darker (brow, iris, nostril), the lighter
+    // (an eye's white) or the middle ones (lips).
+    enum class Tone { Middle, Dark, Light } tone = Tone::Middle;
+    std::optional<cv::Vec3b> colour;  // BGR to use instead of the photo's (the side view takes the front's)
+};
+// What the landmarks tell the drawing: the face parts, and where the photo shows bare skin (its colour is the skin's;
+// empty: the middle of the mask).
+struct DrawingGuide {
+    std::vector<FeatureShape> features;
+    std::vector<std::vector<cv::Point2d>> skinSamples;
+};
+// The guide of a front photo from dlib's 68 points (iBUG order), already in the drawing's pixels: brows, eyes with
+// their irises, nostrils and mouth, sized from the eyes' distance so they stay legible when the photo shows them small.
+DrawingGuide frontDrawingGuide(const std::array<cv::Point2d, 68>& points);
+// The guide of a side photo from its profile points (face_profile's names, in the drawing's pixels) with the face
+// pointing to image left (theta 90): the eye behind the nasion, the brow above it, the lips behind the lip points and
+// a nostril, placed by fractions of the nasion-to-subnasale height. Empty when a point is missing.
+DrawingGuide sideDrawingGuide(const std::map<std::string, cv::Point2d>& profile);
+
 // A photo turned into a flat-coloured drawing with dark outlines, restricted to a mask (the head).
 struct ToonDrawing {
     cv::Mat bgr;      // flat colours, outlines black, outside the mask white
     cv::Mat outline;  // CV_8U, 255 on outline pixels
     cv::Mat mask;     // CV_8U, the head
+    std::vector<cv::Vec3b> featureColours;  // BGR, one per guide feature (what it was painted with)
+    cv::Vec3b skinColour;                   // BGR of the skin region
 };
-// Colour quantisation (k-means on a smoothed photo, `colours` clusters) and edges (boundaries between quantised
-// colours and the mask's own boundary, thickened to `outlineWidth` pixels).
-ToonDrawing toonDrawing(const cv::Mat& photoBgr, const cv::Mat& headMask, int colours = 6, int outlineWidth = 2);
+// Colour quantisation and edges. The skin (pixels within a chroma distance of the skin's colour and not much darker:
+// shading changes lightness, not hue) becomes one flat region; the rest (hair, ears' shade, what the mask holds of the
+// background) is clustered by k-means in Lab with the lightness weighted down (`colours` - 1 clusters, near ones
+// merged); the label map is smoothed by a majority filter and patches under 1/400 of the head's height squared go to
+// their nearest-coloured neighbour; then the guide's features are painted over as regions of their own. Edges are
+// the boundaries between labels and the mask's own boundary, thickened to `outlineWidth` pixels.
+ToonDrawing toonDrawing(const cv::Mat& photoBgr, const cv::Mat& headMask, int colours = 6, int outlineWidth = 2,
+                        const DrawingGuide& guide = {});
 
 // Kitamura's similarity (4.1): s = J exp(-w_x |x_a - x_b|) exp(-w_y |y_a - y_b|) exp(-|S_a - S_b| / ((S_a + S_b)/2))
 // with J = H(T_c - |q_a - q_b|), w_x = 1 when both views share theta else 0.5, w_y likewise for phi. Positions are

@@ -5,6 +5,7 @@
 #include "sim/synthetic_visitor.h"
 #include "test_paths.h"
 #include "toon/toon_billboard.h"
+#include "toon_face_parts.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -70,6 +71,25 @@ TEST(ToonPhotos, SyntheticVisitorBecomesAToonTurntable) {
     cv::flip(last, mirrored, 1);
     EXPECT_EQ(cv::norm(first, mirrored, cv::NORM_INF), 0.0);
     EXPECT_GT(cv::norm(first, middle, cv::NORM_L1), 0.0);
+}
+
+// With the visitor's landmarks (what the fit hands the kiosk) the drawing has the eyes, brows and mouth as regions
+// at their places in both views, matched front to side, and the cheeks are one skin.
+TEST(ToonPhotos, LandmarksGiveTheSyntheticVisitorFacePartsAndOneSkin) {
+    MeshRenderer renderer;
+    SyntheticVisitorOptions options;
+    options.textureSize = 512;
+    const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, options);
+    const cv::Mat frontMask = headMask(visitor.front, visitor.background, visitor.frontLandmarks.at("ibug_08").y);
+    const cv::Mat sideMask = headMask(visitor.side, visitor.background, visitor.sideLandmarks.at("chin").y);
+    ToonLandmarks landmarks;
+    landmarks.front.emplace();
+    for (std::size_t i = 0; i < 68; ++i) (*landmarks.front)[i] = visitor.frontLandmarks.at(cv::format("ibug_%02zu", i));
+    landmarks.side = visitor.sideLandmarks;
+    const ToonModel model = toonFromPhotos(visitor.front, frontMask, visitor.side, sideMask, options.sideNoseImageRight,
+                                           6, 320, landmarks);
+    test::expectFaceParts(model, "synthetic visitor");
+    cv::imwrite((test::scratchDir("toon_face_parts") / "front.png").string(), renderToon(model, 0.0, {400, 440}, 1.0));
 }
 
 }  // namespace
