@@ -5,6 +5,16 @@
 
 namespace avatarbooth {
 
+RenderCamera turningHeadCamera(const glm::dmat4& headModel, const glm::dvec3& centre, double extent, int size) {
+    const glm::dmat4 inverse = glm::inverse(headModel);
+    const glm::dvec3 eye = glm::dvec3(inverse * glm::dvec4(centre + glm::dvec3(0.0, 0.0, 3.0 * extent), 1.0));
+    const glm::dvec3 target = glm::dvec3(inverse * glm::dvec4(centre, 1.0));
+    const glm::dvec3 up = glm::normalize(glm::dvec3(inverse * glm::dvec4(0.0, 1.0, 0.0, 0.0)));
+    RenderCamera camera = RenderCamera::orthographic(eye, target, up, extent * 0.85 / size, size, size);
+    camera.background = cv::Scalar(0, 0, 0);  // transparent black: BGRA's alpha is the coverage
+    return camera;
+}
+
 AvatarStage::AvatarStage(const AnimationSettings& animation, AvatarStageOptions options, HeadlessEglContext* context)
     : renderer_(context ? std::make_unique<MeshRenderer>(
                               *context, MeshRenderer::Options{options.samples, false, options.maxTextureSize})
@@ -35,14 +45,7 @@ const cv::Mat& AvatarStage::frame(bool reveal, Millis since, int size) {
     if (key == shown_ && !image_.empty()) return image_;  // a held pose: the picture has not changed
 
     const auto t0 = std::chrono::steady_clock::now();
-    // Turn the camera the other way round the head's centre instead of moving the mesh: one upload per visitor.
-    const glm::dmat4 inverse = glm::inverse(pose.headModel);
-    const glm::dvec3 eye = glm::dvec3(inverse * glm::dvec4(centre_ + glm::dvec3(0.0, 0.0, 3.0 * extent_), 1.0));
-    const glm::dvec3 target = glm::dvec3(inverse * glm::dvec4(centre_, 1.0));
-    const glm::dvec3 up = glm::normalize(glm::dvec3(inverse * glm::dvec4(0.0, 1.0, 0.0, 0.0)));
-    RenderCamera camera = RenderCamera::orthographic(eye, target, up, extent_ * 0.85 / size, size, size);
-    camera.background = cv::Scalar(0, 0, 0);
-    renderer_->renderBgra(camera, image_);
+    renderer_->renderBgra(turningHeadCamera(pose.headModel, centre_, extent_, size), image_);
     shown_ = key;
     ++version_;
     lastRenderSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

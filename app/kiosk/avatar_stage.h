@@ -24,6 +24,12 @@ struct AvatarStageOptions {
     int maxTextureSize = 1024;
 };
 
+// The camera the kiosk shows a turning head with: orthographic, `size` x `size` pixels, looking at the head's
+// bounding-box centre `centre` (extent: the box's diagonal) from the front, turned the other way round that centre
+// by the pose `headModel` instead of moving the mesh (one upload per visitor). The character style uses the same
+// camera, so the styles turn together.
+RenderCamera turningHeadCamera(const glm::dmat4& headModel, const glm::dvec3& centre, double extent, int size);
+
 // Not thread-safe: its GL context belongs to the thread that made it.
 class AvatarStage {
 public:

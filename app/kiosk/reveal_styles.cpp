@@ -2,6 +2,7 @@
 #include "kiosk/reveal_styles.h"
 
 #include "character/character_head.h"
+#include "kiosk/avatar_stage.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "face/profile.h"
@@ -228,13 +229,7 @@ struct RevealStyles::Impl {
     cv::Mat renderCharacter(const glm::dmat4& model) {
         if (characterPose && *characterPose == model) return characterImage;  // a held frame
         const auto t0 = Clock::now();
-        const glm::dmat4 inverse = glm::inverse(model);
-        const glm::dvec3 eye = glm::dvec3(inverse * glm::dvec4(centre + glm::dvec3(0.0, 0.0, 3.0 * extent), 1.0));
-        const glm::dvec3 target = glm::dvec3(inverse * glm::dvec4(centre, 1.0));
-        const glm::dvec3 up = glm::normalize(glm::dvec3(inverse * glm::dvec4(0.0, 1.0, 0.0, 0.0)));
-        RenderCamera camera = RenderCamera::orthographic(eye, target, up, extent * 0.85 / size, size, size);
-        camera.background = cv::Scalar(0, 0, 0);
-        characterRenderer->renderBgra(camera, characterImage);
+        characterRenderer->renderBgra(turningHeadCamera(model, centre, extent, size), characterImage);
         characterPose = model;
         remember(characterMs, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
         ++figures.characterRenders;

@@ -22,13 +22,27 @@ cv::Mat headMask(const cv::Mat& photo, const cv::Mat& background, double chinRow
     return mask;
 }
 
-TEST(ToonPhotos, SyntheticVisitorBecomesAToonTurntable) {
-    MeshRenderer renderer;
+// The synthetic visitor's two photos with their head masks (cut under the chin), as the kiosk hands them over.
+struct VisitorPhotos {
     SyntheticVisitorOptions options;
-    options.textureSize = 512;
-    const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, options);
-    const cv::Mat frontMask = headMask(visitor.front, visitor.background, visitor.frontLandmarks.at("ibug_08").y);
-    const cv::Mat sideMask = headMask(visitor.side, visitor.background, visitor.sideLandmarks.at("chin").y);
+    SyntheticVisitor visitor;
+    cv::Mat frontMask, sideMask;
+};
+VisitorPhotos visitorPhotos() {
+    MeshRenderer renderer;
+    VisitorPhotos p;
+    p.options.textureSize = 512;
+    p.visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, p.options);
+    p.frontMask = headMask(p.visitor.front, p.visitor.background, p.visitor.frontLandmarks.at("ibug_08").y);
+    p.sideMask = headMask(p.visitor.side, p.visitor.background, p.visitor.sideLandmarks.at("chin").y);
+    return p;
+}
+
+TEST(ToonPhotos, SyntheticVisitorBecomesAToonTurntable) {
+    const VisitorPhotos photos = visitorPhotos();
+    const SyntheticVisitor& visitor = photos.visitor;
+    const SyntheticVisitorOptions& options = photos.options;
+    const cv::Mat &frontMask = photos.frontMask, &sideMask = photos.sideMask;
     const ToonModel model = toonFromPhotos(visitor.front, frontMask, visitor.side, sideMask, options.sideNoseImageRight);
 
     ASSERT_GE(model.regionsA.regions.size(), 3u);
@@ -76,12 +90,10 @@ TEST(ToonPhotos, SyntheticVisitorBecomesAToonTurntable) {
 // With the visitor's landmarks (what the fit hands the kiosk) the drawing has the eyes, brows and mouth as regions
 // at their places in both views, matched front to side, and the cheeks are one skin.
 TEST(ToonPhotos, LandmarksGiveTheSyntheticVisitorFacePartsAndOneSkin) {
-    MeshRenderer renderer;
-    SyntheticVisitorOptions options;
-    options.textureSize = 512;
-    const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, options);
-    const cv::Mat frontMask = headMask(visitor.front, visitor.background, visitor.frontLandmarks.at("ibug_08").y);
-    const cv::Mat sideMask = headMask(visitor.side, visitor.background, visitor.sideLandmarks.at("chin").y);
+    const VisitorPhotos photos = visitorPhotos();
+    const SyntheticVisitor& visitor = photos.visitor;
+    const SyntheticVisitorOptions& options = photos.options;
+    const cv::Mat &frontMask = photos.frontMask, &sideMask = photos.sideMask;
     ToonLandmarks landmarks;
     landmarks.front.emplace();
     for (std::size_t i = 0; i < 68; ++i) (*landmarks.front)[i] = visitor.frontLandmarks.at(cv::format("ibug_%02zu", i));
