@@ -279,8 +279,8 @@ RevealStyles::RevealStyles(const RevealSettings& reveal, const StageSettings& st
     s.fps = animation.fps;
     s.size = avatarSize;
     if (reveal.shows(AvatarStyle::Character)) {
-        // Like the photo avatar (AvatarStage): 2 samples, no depth, a texture no larger than the screen shows.
-        const MeshRenderer::Options options{2, false, 512};
+        // Like the photo avatar (AvatarStage): 1 sample, no depth, a texture no larger than the screen shows.
+        const MeshRenderer::Options options{1, false, 512};
         s.characterRenderer = context ? std::make_unique<MeshRenderer>(*context, options)
                                       : std::make_unique<MeshRenderer>(options);
         // Before any visitor: the base head painted as a character, with its own (average) proportions.

@@ -69,9 +69,10 @@ int copiesToFill(const TileMap& map, double bandAspect) {
 }
 
 StageView::StageView(const Stage& stage, double tileMm, HeadlessEglContext* context) {
-    // Flat-coloured boxes shown every frame while the camera sweeps: 2 samples smooth their edges enough, and the
-    // depth target is never read.
-    const MeshRenderer::Options options{2, false, 0};
+    // Flat-coloured boxes shown every frame while the camera sweeps, at half the band's resolution: 1 sample
+    // (llvmpipe's multisampling is costly; the screen's scaling softens the edges), and the depth target is never
+    // read.
+    const MeshRenderer::Options options{1, false, 0};
     renderer_ = context ? std::make_unique<MeshRenderer>(*context, options) : std::make_unique<MeshRenderer>(options);
     mesh_ = stageMesh(stage, tileMm, palette_);  // (in the body: palette_ is constructed after mesh_)
     renderer_->upload(mesh_, palette_);
