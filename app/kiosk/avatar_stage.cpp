@@ -15,6 +15,13 @@ RenderCamera turningHeadCamera(const glm::dmat4& headModel, const glm::dvec3& ce
     return camera;
 }
 
+void headFraming(const Mesh& mesh, glm::dvec3& centre, double& extent) {
+    glm::dvec3 lo, hi;
+    mesh.bounds(lo, hi);
+    centre = (lo + hi) * 0.5;
+    extent = glm::length(hi - lo);
+}
+
 AvatarStage::AvatarStage(const AnimationSettings& animation, AvatarStageOptions options, HeadlessEglContext* context)
     : renderer_(context ? std::make_unique<MeshRenderer>(
                               *context, MeshRenderer::Options{options.samples, false, options.maxTextureSize})
@@ -26,10 +33,7 @@ AvatarStage::AvatarStage(const AnimationSettings& animation, AvatarStageOptions 
 
 void AvatarStage::show(const Mesh& mesh, const cv::Mat& texture) {
     renderer_->upload(mesh, texture);
-    glm::dvec3 lo, hi;
-    mesh.bounds(lo, hi);
-    centre_ = (lo + hi) * 0.5;
-    extent_ = glm::length(hi - lo);
+    headFraming(mesh, centre_, extent_);
     loaded_ = true;
     ++uploads_;
 }

@@ -30,6 +30,8 @@ struct AvatarStageOptions {
 // by the pose `headModel` instead of moving the mesh (one upload per visitor). The character style uses the same
 // camera, so the styles turn together.
 RenderCamera turningHeadCamera(const glm::dmat4& headModel, const glm::dvec3& centre, double extent, int size);
+// The centre and extent (diagonal) of a head's bounding box, for turningHeadCamera.
+void headFraming(const Mesh& mesh, glm::dvec3& centre, double& extent);
 
 // Not thread-safe: its GL context belongs to the thread that made it.
 class AvatarStage {

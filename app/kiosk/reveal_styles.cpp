@@ -215,10 +215,7 @@ struct RevealStyles::Impl {
 
     void showCharacter(const Mesh& mesh, const cv::Mat& texture) {
         characterRenderer->upload(mesh, texture);
-        glm::dvec3 lo, hi;
-        mesh.bounds(lo, hi);
-        centre = (lo + hi) * 0.5;
-        extent = glm::length(hi - lo);
+        headFraming(mesh, centre, extent);
         characterLoaded = true;
         characterAwaited = false;
         characterPose.reset();

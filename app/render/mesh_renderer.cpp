@@ -591,17 +591,23 @@ void MeshRenderer::drawScene(const RenderCamera& camera, bool withDepth) {
     }
 }
 
-RenderResult MeshRenderer::render(const RenderCamera& camera) {
-    const int width = camera.width, height = camera.height;
-    drawScene(camera, options_.depth);
-
-    // Read back (GL rows start at the bottom) and turn into top-row-first images.
+// The resolved (single-sample) image as the read framebuffer, with the pack state glReadPixels relies on (a borrowed
+// context may have changed it).
+void MeshRenderer::bindResolvedForReadBack() {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolveFbo);
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glPixelStorei(GL_PACK_ROW_LENGTH, 0);
     glPixelStorei(GL_PACK_SKIP_ROWS, 0);
     glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
+}
+
+RenderResult MeshRenderer::render(const RenderCamera& camera) {
+    const int width = camera.width, height = camera.height;
+    drawScene(camera, options_.depth);
+
+    // Read back (GL rows start at the bottom) and turn into top-row-first images.
+    bindResolvedForReadBack();
     cv::Mat rgba(height, width, CV_8UC4), depthCoverage;
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
@@ -630,12 +636,7 @@ RenderResult MeshRenderer::render(const RenderCamera& camera) {
 void MeshRenderer::renderBgra(const RenderCamera& camera, cv::Mat& bgra) {
     const int width = camera.width, height = camera.height;
     drawScene(camera, false);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolveFbo);
-    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-    glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-    glPixelStorei(GL_PACK_SKIP_ROWS, 0);
-    glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
+    bindResolvedForReadBack();
     readBuffer_.create(height, width, CV_8UC4);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, readBuffer_.data);

@@ -111,6 +111,7 @@ private:
     void destroyTargets();
     void ensureTargets(int width, int height);
     void releaseAll();
+    void bindResolvedForReadBack();
     void drawScene(const RenderCamera& camera, bool withDepth);
 
     Options options_;
