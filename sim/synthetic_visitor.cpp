@@ -254,7 +254,18 @@ void writeSyntheticVisitorFolder(const SyntheticVisitor& v, const std::filesyste
     j["pixel_convention"] = "pixel centres at integer coordinates (OpenCV/dlib)";
     for (const auto& [name, p] : v.frontLandmarks) j["front"][name] = {p.x, p.y};
     for (const auto& [name, p] : v.sideLandmarks) j["side"][name] = {p.x, p.y};
-    writeFileAtomically(dir / "truth" / "landmarks.json", j.dump(2) + "\n");
+    writeFileAtomically(dir / "truth" / "landmarks.json", j.dump(2) + "\n");  // last: its presence means complete
+}
+
+std::filesystem::path ensureSyntheticVisitorFolder(const std::filesystem::path& dir) {
+    bool complete = true;
+    for (const char* name : {"front.jpg", "side.jpg", "background.png", "truth/head.glb", "truth/landmarks.json"})
+        complete = complete && std::filesystem::is_regular_file(dir / name);
+    if (!complete) {
+        MeshRenderer renderer;
+        writeSyntheticVisitorFolder(makeSyntheticVisitor(builtinBaseHead(), renderer, SyntheticVisitorOptions{}), dir);
+    }
+    return dir;
 }
 
 }  // namespace avatarbooth

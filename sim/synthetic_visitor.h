@@ -54,4 +54,8 @@ SyntheticVisitor makeSyntheticVisitor(const BaseHead& base, MeshRenderer& render
 // landmarks.json with the ground-truth points and cameras).
 void writeSyntheticVisitorFolder(const SyntheticVisitor& visitor, const std::filesystem::path& dir);
 
+// The default synthetic visitor's folder in `dir`, made (about 2 s and 200 MB: a render) only when it is missing or
+// was left incomplete. Returns `dir`.
+std::filesystem::path ensureSyntheticVisitorFolder(const std::filesystem::path& dir);
+
 }  // namespace avatarbooth

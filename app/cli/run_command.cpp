@@ -6,7 +6,6 @@
 #include "config/booth_config.h"
 #include "drivers/camera/camera_factory.h"
 #include "kiosk/kiosk.h"
-#include "render/mesh_renderer.h"
 #include "sim/sim_visitor.h"
 #include "sim/synthetic_visitor.h"
 
@@ -104,13 +103,8 @@ void registerRunCommand(CLI::App& app) {
         }
         if (config.camera.backend == "sim" && config.camera.simFolder.empty()) {
             // The simulated camera shows the synthetic visitor: a head of known shape with its photos.
-            const fs::path dir = config.sessions.directory.parent_path() / "synthetic-visitor";
-            if (!fs::exists(dir / "front.png")) {
-                MeshRenderer renderer;
-                const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, SyntheticVisitorOptions{});
-                fs::create_directories(dir);
-                writeSyntheticVisitorFolder(visitor, dir);
-            }
+            // (Made once: a restarted booth must be on its attract screen within 2 s.)
+            const fs::path dir = ensureSyntheticVisitorFolder(config.sessions.directory.parent_path() / "synthetic-visitor");
             config.camera.simFolder = dir.string();
             std::cerr << "avatarbooth: the simulated camera shows the synthetic visitor in " << dir.string() << "\n";
         }

@@ -404,3 +404,21 @@ TEST(CameraSim, ReplaysTheSyntheticVisitorFolder) {
     controls->setScene(SimScene::Front);
     EXPECT_LE(cv::norm(camera->nextFrame(1s)->image, cv::imread((folder / "front.jpg").string()), cv::NORM_INF), 2.0);
 }
+
+// The booth makes the default synthetic visitor's folder once (a render of about 2 s that a restarted booth must not
+// repeat before its attract screen), and again only when a file is missing (an earlier run killed while writing it).
+TEST(CameraSim, SyntheticVisitorFolderIsMadeOnceAndRemadeWhenIncomplete) {
+    const auto folder = test::scratchDir("camera_sim_ensure") / "synthetic-visitor";
+    EXPECT_EQ(ensureSyntheticVisitorFolder(folder), folder);
+    for (const char* name : {"front.jpg", "side.jpg", "background.png", "truth/head.glb", "truth/landmarks.json"})
+        ASSERT_TRUE(fs::is_regular_file(folder / name)) << name;
+    const auto made = fs::last_write_time(folder / "front.jpg");
+    ensureSyntheticVisitorFolder(folder);
+    EXPECT_EQ(fs::last_write_time(folder / "front.jpg"), made) << "a complete folder was written again";
+
+    fs::remove(folder / "truth" / "landmarks.json");  // written last: without it the folder is not whole
+    fs::last_write_time(folder / "front.jpg", made - 1h);
+    ensureSyntheticVisitorFolder(folder);
+    EXPECT_TRUE(fs::is_regular_file(folder / "truth" / "landmarks.json"));
+    EXPECT_GT(fs::last_write_time(folder / "front.jpg"), made - 1h);
+}

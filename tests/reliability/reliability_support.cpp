@@ -1,8 +1,6 @@
 // The reliability suite's shared helpers: the fast booth configuration and the sessions-folder checks.
 #include "reliability_support.h"
 
-#include "head/base_head.h"
-#include "render/mesh_renderer.h"
 #include "sim/synthetic_visitor.h"
 
 #include <nlohmann/json.hpp>
@@ -53,16 +51,7 @@ BoothConfig fastSimBooth(const fs::path& visitorFolder, const fs::path& sessions
     return c;
 }
 
-fs::path syntheticVisitorFolder(const fs::path& dir) {
-    const fs::path folder = dir / "synthetic-visitor";
-    if (!fs::exists(folder / "front.jpg") && !fs::exists(folder / "front.png")) {
-        MeshRenderer renderer;
-        const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, SyntheticVisitorOptions{});
-        fs::create_directories(folder);
-        writeSyntheticVisitorFolder(visitor, folder);
-    }
-    return folder;
-}
+fs::path syntheticVisitorFolder(const fs::path& dir) { return ensureSyntheticVisitorFolder(dir / "synthetic-visitor"); }
 
 const std::vector<std::string>& sessionFiles() {
     static const std::vector<std::string> files = {"avatar.glb",     "fit.json",  "landmarks.json", "session.json",
