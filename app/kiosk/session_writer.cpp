@@ -56,7 +56,6 @@ void SessionWriter::run() {
         if (errno == 0 && setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), now + niceness_) != 0)
             spdlog::debug("session writer keeps its priority: {}", std::strerror(errno));
     }
-    std::unique_ptr<MeshRenderer> renderer;
     for (;;) {
         Job job;
         {
@@ -72,10 +71,13 @@ void SessionWriter::run() {
         done.folder = job.folder;
         const auto t0 = std::chrono::steady_clock::now();
         try {
-            if (!renderer) renderer = std::make_unique<MeshRenderer>();
+            // A renderer (and its GL context) for this job only: held between sessions, its buffers, texture and
+            // compiled shaders kept about 40 MB through every attract screen and guide. Two samples and no depth
+            // target are enough for the 512-pixel preview PNGs (the peak RSS of a session is a target: issue 3).
+            MeshRenderer renderer(MeshRendererOptions{.maxSamples = 2, .depth = false});
             // No input files: the photos are in memory and are written as JPEGs (file names here would be read
             // from the working directory).
-            job.pipeline->write(*job.outcome, FitInputs{}, job.folder, *renderer, job.character.get());
+            job.pipeline->write(*job.outcome, FitInputs{}, job.folder, renderer, job.character.get());
         } catch (const BoothError& e) {
             done.error = e;
         } catch (const std::exception& e) {
