@@ -99,6 +99,16 @@ private:
         // when the write ends), and still at the next end after a visitor who walked away at once. One still there
         // a minute after it was first seen is stuck: a discarded or failed fit must leave nothing behind.
         samples.back().quiet = check.leftovers == 0;
+        // A line every 100 sessions: a run of thousands takes hours, and one stopped early still has its figures.
+        if (samples.size() % 100 == 0) {
+            const Sample& x = samples.back();
+            std::printf("soak: progress %zu sessions, %.0f s, rss %.1f MB, heap %.1f in use / %.1f free MB, "
+                        "%d open files, %d threads\n",
+                        samples.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(),
+                        x.process.rssMegabytes, x.heapInUseMegabytes, x.heapFreeMegabytes, x.process.openFiles,
+                        x.process.threads);
+            std::fflush(stdout);
+        }
         leftoversSeen += check.leftovers;
         const auto t = std::chrono::steady_clock::now();
         std::map<std::string, std::chrono::steady_clock::time_point> now;
@@ -131,6 +141,7 @@ private:
     std::set<std::string> counted_;
     std::map<std::string, std::chrono::steady_clock::time_point> pendingBefore_;  // pending entry -> first seen
     std::set<std::string> reported_;
+    const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
 }  // namespace
