@@ -78,9 +78,10 @@ cv::Mat readImage(const fs::path& path) {
     return image;
 }
 
-// `image` scaled to fit in `size` (aspect kept), centred on the neutral backdrop.
+// `image` scaled to fit in `size` (aspect kept), centred on the neutral backdrop. An image that already fits is
+// shared, not copied (the camera never writes into its stills or previews: every frame is a copy).
 cv::Mat fitInto(const cv::Mat& image, cv::Size size) {
-    if (image.size() == size) return image.clone();
+    if (image.size() == size) return image;
     const double scale = std::min(static_cast<double>(size.width) / image.cols, static_cast<double>(size.height) / image.rows);
     const cv::Size scaled(std::max(1, static_cast<int>(std::lround(image.cols * scale))),
                           std::max(1, static_cast<int>(std::lround(image.rows * scale))));
