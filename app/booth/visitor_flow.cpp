@@ -169,11 +169,13 @@ std::vector<FlowCommand> VisitorFlow::handle(const FlowEvent& event) {
                    [&](const SessionSaved& e) {
                        if (state_ != State::Thanks) return;
                        screen_.code = e.code;
+                       if (!thanksResultAt_) thanksResultAt_ = e.t;
                    },
                    [&](const SessionSaveFailed& e) {
                        if (state_ != State::Thanks) return;
                        banner_ = BannerKind::SaveFailed;
                        bannerDetail_ = e.detail;
+                       if (!thanksResultAt_) thanksResultAt_ = e.t;
                    },
                    [&](const CameraLost& e) {
                        cameraDetail_ = e.detail;
@@ -238,7 +240,8 @@ void VisitorFlow::advance(FlowTime t, std::vector<FlowCommand>& out) {
             if (in >= settings_.retakeChoiceTimeout) enter(State::Reveal, t, out);
             break;
         case State::Thanks:
-            if (in >= settings_.thanksTime) toAttract(t, out);
+            if (thanksResultAt_ ? t - *thanksResultAt_ >= settings_.thanksTime : in >= settings_.thanksSavingLimit)
+                toAttract(t, out);
             break;
         case State::CameraLost:
             if (in >= settings_.cameraLostTimeout) toAttract(t, out);
@@ -338,6 +341,7 @@ void VisitorFlow::enter(State s, FlowTime t, std::vector<FlowCommand>& out) {
     state_ = s;
     enteredAt_ = t;
     okSince_.reset();
+    thanksResultAt_.reset();
     if (s == State::Countdown) banner_ = BannerKind::None;  // the visitor has seen why; a new photo is coming
     if (s == State::Guide) {
         lastSeen_ = t;

@@ -444,9 +444,12 @@ std::vector<ConfigKey> makeKeys() {
     k.push_back(seconds("flow", "retake_choice_timeout_s", FIELD(flow.retakeChoiceTimeout), 2.0, 600.0,
                         "The \"which photo?\" question goes back to the reveal after this long."));
     k.push_back(seconds("flow", "thanks_time_s", FIELD(flow.thanksTime), 1.0, 600.0,
-                        "The thanks screen with the session's code is shown this long."));
+                        "The thanks screen shows the session's code (or that it could not be saved) this long."));
     k.push_back(seconds("flow", "thanks_min_time_s", FIELD(flow.thanksMinTime), 0.0, 600.0,
                         "... and ignores the Start button this long, so the code is not skipped by the next visitor."));
+    k.push_back(seconds("flow", "thanks_saving_limit_s", FIELD(flow.thanksSavingLimit), 1.0, 3600.0,
+                        "While the kept session is still being written the thanks screen says \"saving\" and waits "
+                        "for its code, at most this long (then back to attract; the write goes on)."));
     k.push_back(seconds("flow", "camera_lost_timeout_s", FIELD(flow.cameraLostTimeout), 1.0, 3600.0,
                         "A session whose camera was lost is given up after this long."));
     k.push_back(seconds("flow", "press_guard_s", FIELD(flow.pressGuard), 0.0, 5.0,

@@ -179,10 +179,10 @@ TEST(VisitorFlow, WholeSessionKept) {
     EXPECT_EQ(b.model().code, "");
     b.send(SessionSaved{"AB3K7Z", at(b.now + 0.1)});
     EXPECT_EQ(b.model().code, "AB3K7Z");
-    const double thanksAt = b.now - 0.1 - 0.1;  // the press (0.1 s before the release, 0.1 s before the save)
-    b.tickAt(thanksAt + 19.99);
+    const double savedAt = b.now;  // the code shows its 20 s from when it is known
+    b.tickAt(savedAt + 19.99);
     EXPECT_EQ(b.screen(), ScreenId::Thanks);
-    EXPECT_EQ(b.tickAt(thanksAt + 20.0), Names{kLampsAttract});  // kept: nothing to discard
+    EXPECT_EQ(b.tickAt(savedAt + 20.0), Names{kLampsAttract});  // kept: nothing to discard
     EXPECT_EQ(b.screen(), ScreenId::Attract);
 }
 
@@ -391,6 +391,35 @@ TEST(VisitorFlow, ThanksShowsASaveFailure) {
     b.after(20.0);
     EXPECT_EQ(b.screen(), ScreenId::Attract);
     EXPECT_EQ(b.model().banner, BannerKind::None);
+}
+
+TEST(VisitorFlow, ThanksWaitsForASlowSaveThenShowsTheCodeItsFullTime) {
+    Booth b;
+    b.toThanks();
+    const double entered = b.now - 0.1;  // the press that kept the session (its release came 0.1 s later)
+    EXPECT_EQ(b.tickAt(entered + 45.0), Names{});  // still "saving": the visitor waits for the code
+    EXPECT_EQ(b.screen(), ScreenId::Thanks);
+    EXPECT_EQ(b.model().code, "");
+    b.send(SessionSaved{"AB3K7Z", at(entered + 50.0)});
+    EXPECT_EQ(b.model().code, "AB3K7Z");
+    b.tickAt(entered + 69.9);
+    EXPECT_EQ(b.screen(), ScreenId::Thanks);  // 20 s of code from when it came, not from the keep
+    EXPECT_EQ(b.tickAt(entered + 70.0), Names{kLampsAttract});
+    EXPECT_EQ(b.screen(), ScreenId::Attract);
+}
+
+TEST(VisitorFlow, ThanksGivesUpWaitingForTheSaveAfterItsLimit) {
+    BoothSettings s;
+    s.thanksSavingLimit = Millis(30000);
+    Booth b(s);
+    b.toThanks();
+    const double entered = b.now - 0.1;
+    b.tickAt(entered + 29.9);
+    EXPECT_EQ(b.screen(), ScreenId::Thanks);
+    EXPECT_EQ(b.tickAt(entered + 30.0), Names{kLampsAttract});
+    EXPECT_EQ(b.screen(), ScreenId::Attract);
+    b.send(SessionSaved{"AB3K7Z", at(entered + 31.0)});  // the write ended after all: nothing shows it to the next visitor
+    EXPECT_EQ(b.model().code, "");
 }
 
 // ------------------------------------------------------------------------------------------------------ retakes
