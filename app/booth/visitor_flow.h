@@ -31,14 +31,14 @@ struct BoothSettings {
     Millis revealTimeout{60000};
     // The "which photo?" question goes back to the reveal after this long.
     Millis retakeChoiceTimeout{20000};
-    // The thanks screen shows the session's code (or that it could not be saved) this long ...
+    // The thanks screen shows the session's code (or that it could not be saved) this long, counted from when the
+    // code is known ...
     Millis thanksTime{20000};
-    // ... counted from when the code is known: while the kept session is still being written (a slow card) the
-    // screen says "saving" and waits, but at most this long; then the booth goes back to attract (the write goes on
-    // and its result is logged).
-    Millis thanksSavingLimit{120000};
     // ... and ignores the Start button for this long, so the code is not skipped by an eager next visitor.
     Millis thanksMinTime{5000};
+    // While the kept session is still being written (a slow card) the thanks screen says "saving" and waits for
+    // the code, but at most this long; then the booth goes back to attract (the write goes on, its result logged).
+    Millis thanksSavingLimit{120000};
     // With the camera lost in the middle of a session, the session is given up after this long.
     Millis cameraLostTimeout{60000};
     // Presses within this long of a screen change are ignored, so a double press does not also act on the
@@ -90,7 +90,7 @@ private:
     BoothSettings settings_;
     State state_ = State::Attract;
     FlowTime enteredAt_;
-    std::optional<FlowTime> thanksResultAt_;  // when the thanks screen learnt the code or the save's failure
+    std::optional<FlowTime> thanksResultAt_;  // thanks: when the code or the save's failure became known
     FlowTime lastSeen_;                    // guides: last preview with a person (or the guide's start)
     std::optional<FlowTime> okSince_;      // guides: start of the current run of "hold still"
     FlowTime lastOperatorPress_;
