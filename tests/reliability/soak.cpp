@@ -2,7 +2,7 @@
 // walk-aways, retakes of either photo, keeps and discards — and the process's memory, threads and open files are
 // sampled whenever the booth is back on the attract screen. Prints the figures; exits 1 when one is out of bounds.
 //
-// Usage: reliability_soak [--sessions N] [--seed S] [--warmup W] [--work DIR] [--max-drift-mb M]
+// Usage: reliability_soak [--sessions N] [--seed S] [--warmup W] [--work DIR] [--max-drift-mb M] [--samples-csv F]
 #include "reliability_support.h"
 
 #include "common/error.h"
@@ -15,6 +15,7 @@
 #include <malloc.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -68,6 +69,30 @@ double slopePer100(const std::vector<Sample>& s, std::size_t from, F value) {
         sxx += (static_cast<double>(i) - mx) * (static_cast<double>(i) - mx);
     }
     return 100.0 * sxy / sxx;
+}
+
+// The RSS the booth settles at over the samples [from, to): the median of the quiet ones (no session write in
+// flight; the writer's images, mesh and GL context add 10-40 MB while it works), or of all of them when none is
+// quiet. One reading scatters by about ±12 MB with what the last visitor did (walked away, kept, toon drawn), so a
+// drift taken from two single readings measures that scatter, not a leak; the medians of two windows of a hundred
+// sessions each do not.
+struct SettledRss {
+    double megabytes = 0.0;
+    int quiet = 0;  // how many quiet samples the median is over (0: over all of them)
+};
+
+SettledRss settledRss(const std::vector<Sample>& s, std::size_t from, std::size_t to) {
+    std::vector<double> quiet, all;
+    for (std::size_t i = from; i < to && i < s.size(); ++i) {
+        all.push_back(s[i].process.rssMegabytes);
+        if (s[i].quiet) quiet.push_back(s[i].process.rssMegabytes);
+    }
+    std::vector<double>& v = quiet.empty() ? all : quiet;
+    if (v.empty()) return {};
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    return {median, static_cast<int>(quiet.size())};
 }
 
 // Watches the booth through the visitor's eyes: samples the process each time the attract screen comes back,
@@ -151,6 +176,7 @@ int main(int argc, char** argv) {
     std::uint64_t seed = 1;
     double maxDrift = 5.0;
     fs::path work = fs::temp_directory_path() / "avatarbooth-soak";
+    fs::path samplesCsv;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         const auto value = [&]() -> std::string {
@@ -165,8 +191,10 @@ int main(int argc, char** argv) {
         else if (a == "--warmup") warmup = std::stoi(value());
         else if (a == "--work") work = value();
         else if (a == "--max-drift-mb") maxDrift = std::stod(value());
+        else if (a == "--samples-csv") samplesCsv = value();
         else {
-            std::cerr << "usage: reliability_soak [--sessions N] [--seed S] [--warmup W] [--work DIR] [--max-drift-mb M]\n";
+            std::cerr << "usage: reliability_soak [--sessions N] [--seed S] [--warmup W] [--work DIR] [--max-drift-mb M] "
+                         "[--samples-csv FILE]\n";
             return 2;
         }
     }
@@ -218,7 +246,14 @@ int main(int argc, char** argv) {
         maxThreads = std::max(maxThreads, s[i].process.threads);
     }
     if (quietSamples == 0) minFds = maxFds = minThreads = maxThreads = 0;
-    const double drift = s.size() > w ? last.rssMegabytes - warm.rssMegabytes : 0.0;
+    // The drift: where RSS settles over the last tenth of the samples after warm-up, minus where it settled over
+    // the first tenth (at least 3 samples each; see settledRss). A leak of 3 kB a session climbs 5 MB over 1800.
+    const std::size_t after = s.size() > w ? s.size() - w : 0;
+    const std::size_t window = std::max<std::size_t>(3, after / 10);
+    const SettledRss settledFirst = settledRss(s, w, w + window);
+    const SettledRss settledLast = settledRss(s, s.size() > window ? std::max(w, s.size() - window) : w, s.size());
+    const double drift = after > 0 ? settledLast.megabytes - settledFirst.megabytes : 0.0;
+    const double singleDrift = after > 0 ? last.rssMegabytes - warm.rssMegabytes : 0.0;
     const auto rss = [](const Sample& x) { return x.process.rssMegabytes; };
     const auto inUse = [](const Sample& x) { return x.heapInUseMegabytes; };
     const auto heapFree = [](const Sample& x) { return x.heapFreeMegabytes; };
@@ -249,9 +284,13 @@ int main(int argc, char** argv) {
                 "%d pending seen between sessions (writes in flight), %zu stuck\n",
                 probe.checkedComplete, probe.withToon.size(), probe.problems.size(), probe.leftoversSeen,
                 probe.stuck.size());
-    std::printf("soak: rss MB                peak %.1f (whole run), after warm-up (%d sessions) %.1f, final %.1f, "
-                "drift %+.2f, peak after warm-up %.1f\n",
-                end.peakRssMegabytes, warmup, warm.rssMegabytes, last.rssMegabytes, drift, peakAfterWarmup);
+    std::printf("soak: rss MB                peak %.1f (whole run), after warm-up (%d sessions) %.1f, final %.1f "
+                "(single readings: %+.2f), peak after warm-up %.1f\n",
+                end.peakRssMegabytes, warmup, warm.rssMegabytes, last.rssMegabytes, singleDrift, peakAfterWarmup);
+    std::printf("soak: rss drift MB          %+.2f: settled %.1f over the last %zu sessions (median of %d quiet ends) "
+                "- %.1f over the first %zu after warm-up (median of %d)\n",
+                drift, settledLast.megabytes, window, settledLast.quiet, settledFirst.megabytes, window,
+                settledFirst.quiet);
     std::printf("soak: rss MB by session     %s\n", points.c_str());
     std::printf("soak: rss slope MB/100      %+.2f after warm-up, %+.2f over the second half\n", slopePer100(s, w, rss),
                 slopePer100(s, half, rss));
@@ -262,6 +301,20 @@ int main(int argc, char** argv) {
                 "write in flight)\n", warm.openFiles, last.openFiles, minFds, maxFds, quietSamples);
     std::printf("soak: threads               after warm-up %d, final %d, range %d..%d\n", warm.threads,
                 last.threads, minThreads, maxThreads);
+    if (!samplesCsv.empty()) {
+        // Every sample, for plotting or another estimator: session,quiet,rss_mb,heap_in_use_mb,heap_free_mb,fds,threads
+        if (FILE* f = std::fopen(samplesCsv.c_str(), "w")) {
+            std::fprintf(f, "session,quiet,rss_mb,heap_in_use_mb,heap_free_mb,open_files,threads\n");
+            for (std::size_t i = 0; i < s.size(); ++i)
+                std::fprintf(f, "%zu,%d,%.2f,%.2f,%.2f,%d,%d\n", i + 1, s[i].quiet ? 1 : 0, s[i].process.rssMegabytes,
+                             s[i].heapInUseMegabytes, s[i].heapFreeMegabytes, s[i].process.openFiles,
+                             s[i].process.threads);
+            std::fclose(f);
+            std::printf("soak: samples               %s\n", samplesCsv.c_str());
+        } else {
+            std::printf("soak: samples               could not write %s: %s\n", samplesCsv.c_str(), std::strerror(errno));
+        }
+    }
     for (const auto& p : probe.stuck) std::printf("soak: STUCK %s\n", p.c_str());
     for (const auto& p : probe.problems) std::printf("soak: PROBLEM %s\n", p.c_str());
 
