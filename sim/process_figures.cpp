@@ -19,6 +19,8 @@ ProcessFigures readProcessFigures() {
         fields >> key >> value;
         if (key == "VmRSS:") f.rssMegabytes = value / 1024.0;
         else if (key == "VmHWM:") f.peakRssMegabytes = value / 1024.0;
+        else if (key == "RssAnon:") f.anonRssMegabytes = value / 1024.0;
+        else if (key == "RssFile:") f.fileRssMegabytes = value / 1024.0;
         else if (key == "Threads:") f.threads = static_cast<int>(value);
     }
     std::error_code ec;

@@ -1,5 +1,5 @@
 // The process's own resource figures from /proc/self (resident memory, threads, open file descriptors), for the
-// soak test's leak checks.
+// soak test's leak checks and the memory benchmarks.
 #pragma once
 
 namespace avatarbooth {
@@ -7,6 +7,8 @@ namespace avatarbooth {
 struct ProcessFigures {
     double rssMegabytes = 0.0;      // VmRSS now
     double peakRssMegabytes = 0.0;  // VmHWM: the most resident so far
+    double anonRssMegabytes = 0.0;  // RssAnon: of VmRSS, the process's own memory (heap, stacks, mappings)
+    double fileRssMegabytes = 0.0;  // RssFile: of VmRSS, pages of mapped files (the libraries, shareable)
     int threads = 0;
     int openFiles = 0;              // entries of /proc/self/fd
 };

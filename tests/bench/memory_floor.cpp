@@ -8,6 +8,7 @@
 #include "face/landmarks68.h"
 #include "head/base_head.h"
 #include "render/mesh_renderer.h"
+#include "sim/process_figures.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -21,23 +22,10 @@ using namespace avatarbooth;
 
 namespace {
 
-// /proc/self/status's sizes in MB, by key ("VmRSS:", ...).
-std::map<std::string, double> status() {
-    std::map<std::string, double> out;
-    std::ifstream in("/proc/self/status");
-    for (std::string line; std::getline(in, line);) {
-        std::istringstream fields(line);
-        std::string key;
-        long value = 0;
-        if (fields >> key >> value) out[key] = static_cast<double>(value) / 1024.0;
-    }
-    return out;
-}
-
 void step(const char* what) {
-    auto s = status();
-    std::printf("memory floor: %-48s rss %4.0f MB (anonymous %4.0f, library pages %4.0f)\n", what, s["VmRSS:"],
-                s["RssAnon:"], s["RssFile:"]);
+    const ProcessFigures f = readProcessFigures();
+    std::printf("memory floor: %-48s rss %4.0f MB (anonymous %4.0f, library pages %4.0f)\n", what, f.rssMegabytes,
+                f.anonRssMegabytes, f.fileRssMegabytes);
 }
 
 // Resident pages per mapped file, largest first.
@@ -83,7 +71,7 @@ int main(int argc, char** argv) {
         step("+ the base head drawn once (shaders compiled)");
         const LandmarkDetector detector(argc > 1 ? argv[1] : AVATARBOOTH_DEFAULT_DLIB_MODEL);
         step("+ dlib's face detector and 68-point model");
-        std::printf("memory floor: peak %.0f MB; the libraries holding the most pages:\n", status()["VmHWM:"]);
+        std::printf("memory floor: peak %.0f MB; the libraries holding the most pages:\n", readProcessFigures().peakRssMegabytes);
         topLibraries(6);
     }
     return 0;
