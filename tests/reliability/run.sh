@@ -27,7 +27,7 @@ cmake --build "$build" -j "$(nproc)" --target avatarbooth reliability_soak relia
 
 status=0
 echo "== soak ($sessions sessions)"
-"$build/tests/reliability/reliability_soak" --sessions "$sessions" --work "$out/soak" | tee "$out/soak.txt" || status=1
+"$build/tests/reliability/reliability_soak" --sessions "$sessions" --work "$out/soak" --samples-csv "$out/soak_samples.csv" | tee "$out/soak.txt" || status=1
 echo "== faults"
 "$build/tests/reliability/reliability_tests" --gtest_filter='-BadInputFiles.*' 2>&1 | tee "$out/faults.txt" | grep -E '^figure:|^\[  (PASSED|FAILED|SKIPPED) |Failure|error:' || true
 grep -q '^\[  FAILED' "$out/faults.txt" && status=1
