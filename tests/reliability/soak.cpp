@@ -5,6 +5,7 @@
 // Usage: reliability_soak [--sessions N] [--seed S] [--warmup W] [--work DIR] [--max-drift-mb M] [--samples-csv F]
 #include "reliability_support.h"
 
+#include "common/atomic_output.h"
 #include "common/error.h"
 #include "kiosk/kiosk.h"
 #include "sim/process_figures.h"
@@ -15,7 +16,6 @@
 #include <malloc.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -247,9 +247,10 @@ int main(int argc, char** argv) {
     }
     if (quietSamples == 0) minFds = maxFds = minThreads = maxThreads = 0;
     // The drift: where RSS settles over the last tenth of the samples after warm-up, minus where it settled over
-    // the first tenth (at least 3 samples each; see settledRss). A leak of 3 kB a session climbs 5 MB over 1800.
+    // the first tenth (at least 3 samples each, without overlapping; see settledRss). A leak of 3 kB a session
+    // climbs 5 MB over 1800.
     const std::size_t after = s.size() > w ? s.size() - w : 0;
-    const std::size_t window = std::max<std::size_t>(3, after / 10);
+    const std::size_t window = std::max<std::size_t>(1, std::min(std::max<std::size_t>(3, after / 10), after / 2));
     const SettledRss settledFirst = settledRss(s, w, w + window);
     const SettledRss settledLast = settledRss(s, s.size() > window ? std::max(w, s.size() - window) : w, s.size());
     const double drift = after > 0 ? settledLast.megabytes - settledFirst.megabytes : 0.0;
@@ -302,17 +303,20 @@ int main(int argc, char** argv) {
     std::printf("soak: threads               after warm-up %d, final %d, range %d..%d\n", warm.threads,
                 last.threads, minThreads, maxThreads);
     if (!samplesCsv.empty()) {
-        // Every sample, for plotting or another estimator: session,quiet,rss_mb,heap_in_use_mb,heap_free_mb,fds,threads
-        if (FILE* f = std::fopen(samplesCsv.c_str(), "w")) {
-            std::fprintf(f, "session,quiet,rss_mb,heap_in_use_mb,heap_free_mb,open_files,threads\n");
-            for (std::size_t i = 0; i < s.size(); ++i)
-                std::fprintf(f, "%zu,%d,%.2f,%.2f,%.2f,%d,%d\n", i + 1, s[i].quiet ? 1 : 0, s[i].process.rssMegabytes,
-                             s[i].heapInUseMegabytes, s[i].heapFreeMegabytes, s[i].process.openFiles,
-                             s[i].process.threads);
-            std::fclose(f);
+        // Every sample, for plotting or another estimator (written whole or not at all).
+        std::string csv = "session,quiet,rss_mb,heap_in_use_mb,heap_free_mb,open_files,threads\n";
+        for (std::size_t i = 0; i < s.size(); ++i) {
+            char row[160];
+            std::snprintf(row, sizeof row, "%zu,%d,%.2f,%.2f,%.2f,%d,%d\n", i + 1, s[i].quiet ? 1 : 0,
+                          s[i].process.rssMegabytes, s[i].heapInUseMegabytes, s[i].heapFreeMegabytes,
+                          s[i].process.openFiles, s[i].process.threads);
+            csv += row;
+        }
+        try {
+            writeFileAtomically(samplesCsv, csv);
             std::printf("soak: samples               %s\n", samplesCsv.c_str());
-        } else {
-            std::printf("soak: samples               could not write %s: %s\n", samplesCsv.c_str(), std::strerror(errno));
+        } catch (const std::exception& e) {
+            std::printf("soak: samples               not written: %s\n", e.what());
         }
     }
     for (const auto& p : probe.stuck) std::printf("soak: STUCK %s\n", p.c_str());
