@@ -71,7 +71,8 @@ int main(int argc, char** argv) {
         step("+ the base head drawn once (shaders compiled)");
         const LandmarkDetector detector(argc > 1 ? argv[1] : AVATARBOOTH_DEFAULT_DLIB_MODEL);
         step("+ dlib's face detector and 68-point model");
-        std::printf("memory floor: peak %.0f MB; the libraries holding the most pages:\n", readProcessFigures().peakRssMegabytes);
+        std::printf("memory floor: peak %.0f MB; the libraries holding the most pages:\n",
+                    readProcessFigures().peakRssMegabytes);
         topLibraries(6);
     }
     return 0;

@@ -78,7 +78,7 @@ double slopePer100(const std::vector<Sample>& s, std::size_t from, F value) {
 // sessions each do not.
 struct SettledRss {
     double megabytes = 0.0;
-    int quiet = 0;  // how many quiet samples the median is over (0: over all of them)
+    std::string over;  // what the median is over: "N quiet ends", or "all N ends, none quiet"
 };
 
 SettledRss settledRss(const std::vector<Sample>& s, std::size_t from, std::size_t to) {
@@ -88,11 +88,12 @@ SettledRss settledRss(const std::vector<Sample>& s, std::size_t from, std::size_
         if (s[i].quiet) quiet.push_back(s[i].process.rssMegabytes);
     }
     std::vector<double>& v = quiet.empty() ? all : quiet;
-    if (v.empty()) return {};
+    if (v.empty()) return {0.0, "no ends"};
     std::sort(v.begin(), v.end());
     const std::size_t n = v.size();
     const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-    return {median, static_cast<int>(quiet.size())};
+    const std::string count = std::to_string(n);
+    return {median, quiet.empty() ? "all " + count + " ends, none quiet" : count + " quiet ends"};
 }
 
 // Watches the booth through the visitor's eyes: samples the process each time the attract screen comes back,
@@ -288,10 +289,10 @@ int main(int argc, char** argv) {
     std::printf("soak: rss MB                peak %.1f (whole run), after warm-up (%d sessions) %.1f, final %.1f "
                 "(single readings: %+.2f), peak after warm-up %.1f\n",
                 end.peakRssMegabytes, warmup, warm.rssMegabytes, last.rssMegabytes, singleDrift, peakAfterWarmup);
-    std::printf("soak: rss drift MB          %+.2f: settled %.1f over the last %zu sessions (median of %d quiet ends) "
-                "- %.1f over the first %zu after warm-up (median of %d)\n",
-                drift, settledLast.megabytes, window, settledLast.quiet, settledFirst.megabytes, window,
-                settledFirst.quiet);
+    std::printf("soak: rss drift MB          %+.2f: settled %.1f over the last %zu sessions (median of %s) "
+                "- %.1f over the first %zu after warm-up (median of %s)\n",
+                drift, settledLast.megabytes, window, settledLast.over.c_str(), settledFirst.megabytes, window,
+                settledFirst.over.c_str());
     std::printf("soak: rss MB by session     %s\n", points.c_str());
     std::printf("soak: rss slope MB/100      %+.2f after warm-up, %+.2f over the second half\n", slopePer100(s, w, rss),
                 slopePer100(s, half, rss));
