@@ -31,4 +31,25 @@ ProcessFigures readProcessFigures() {
     return f;
 }
 
+std::map<std::string, double> residentByMapping() {
+    std::map<std::string, double> resident;
+    std::ifstream smaps("/proc/self/smaps");
+    std::string line, name = "[anon]";
+    while (std::getline(smaps, line)) {
+        // A mapping's header: "start-end perms offset dev inode [path]"; its fields: "Key:   value kB".
+        const auto colon = line.find(':');
+        const auto space = line.find(' ');
+        if (space != std::string::npos && (colon == std::string::npos || colon > space)) {
+            std::istringstream header(line);
+            std::string range, perms, offset, dev, inode, path;
+            header >> range >> perms >> offset >> dev >> inode;
+            std::getline(header >> std::ws, path);
+            name = path.empty() ? "[anon]" : path;
+        } else if (line.compare(0, 4, "Rss:") == 0) {
+            resident[name] += std::stod(line.substr(4)) / 1024.0;
+        }
+    }
+    return resident;
+}
+
 }  // namespace avatarbooth

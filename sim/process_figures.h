@@ -2,6 +2,9 @@
 // soak test's leak checks and the memory benchmarks.
 #pragma once
 
+#include <map>
+#include <string>
+
 namespace avatarbooth {
 
 struct ProcessFigures {
@@ -14,5 +17,10 @@ struct ProcessFigures {
 };
 
 ProcessFigures readProcessFigures();
+
+// Resident megabytes per mapping name from /proc/self/smaps, summed over the mappings of each name: a library's
+// path, "[heap]" (the brk heap: glibc's main arena), "[stack]", and "[anon]" for the anonymous mappings (other
+// arenas, large blocks, JIT code). Where a slow climb of VmRSS comes from. Empty when smaps cannot be read.
+std::map<std::string, double> residentByMapping();
 
 }  // namespace avatarbooth

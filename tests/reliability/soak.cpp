@@ -40,6 +40,8 @@ struct Sample {
     bool quiet = true;  // nothing pending: no session folder being written in the background (its file is open)
     double heapInUseMegabytes = 0.0;
     double heapFreeMegabytes = 0.0;
+    double brkHeapMegabytes = 0.0;    // resident in the brk heap (glibc's main arena)
+    double anonOtherMegabytes = 0.0;  // resident in anonymous mappings (other arenas, large blocks, llvmpipe's code)
 };
 
 Sample takeSample() {
@@ -48,6 +50,13 @@ Sample takeSample() {
     const struct mallinfo2 m = mallinfo2();
     s.heapInUseMegabytes = static_cast<double>(m.uordblks + m.hblkhd) / (1024.0 * 1024.0);
     s.heapFreeMegabytes = static_cast<double>(m.fordblks) / (1024.0 * 1024.0);
+    const std::map<std::string, double> resident = residentByMapping();
+    const auto at = [&](const char* name) {
+        const auto it = resident.find(name);
+        return it == resident.end() ? 0.0 : it->second;
+    };
+    s.brkHeapMegabytes = at("[heap]");
+    s.anonOtherMegabytes = at("[anon]");
     return s;
 }
 
@@ -100,7 +109,8 @@ SettledRss settledRss(const std::vector<Sample>& s, std::size_t from, std::size_
 // and clears old kept sessions (after checking them) so that thousands of sessions do not fill the disk.
 class SoakProbe final : public VisitorScript {
 public:
-    SoakProbe(VisitorScript& visitor, fs::path sessions) : visitor_(visitor), sessions_(std::move(sessions)) {}
+    SoakProbe(VisitorScript& visitor, fs::path sessions, fs::path mappingsCsv)
+        : visitor_(visitor), sessions_(std::move(sessions)), mappingsCsv_(std::move(mappingsCsv)) {}
 
     Action step(const ScreenModel& screen, FlowTime now) override {
         if (screen.id == ScreenId::Attract && last_ != ScreenId::Attract) sessionEnded();
@@ -128,12 +138,14 @@ private:
         // A line every 100 sessions: a run of thousands takes hours, and one stopped early still has its figures.
         if (samples.size() % 100 == 0) {
             const Sample& x = samples.back();
-            std::printf("soak: progress %zu sessions, %.0f s, rss %.1f MB, heap %.1f in use / %.1f free MB, "
-                        "%d open files, %d threads\n",
+            std::printf("soak: progress %zu sessions, %.0f s, rss %.1f MB (anon %.1f: brk heap %.1f, mappings %.1f; "
+                        "files %.1f), heap %.1f in use / %.1f free MB, %d open files, %d threads\n",
                         samples.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(),
-                        x.process.rssMegabytes, x.heapInUseMegabytes, x.heapFreeMegabytes, x.process.openFiles,
+                        x.process.rssMegabytes, x.process.anonRssMegabytes, x.brkHeapMegabytes, x.anonOtherMegabytes,
+                        x.process.fileRssMegabytes, x.heapInUseMegabytes, x.heapFreeMegabytes, x.process.openFiles,
                         x.process.threads);
             std::fflush(stdout);
+            if (!mappingsCsv_.empty()) writeMappings(x);
         }
         leftoversSeen += check.leftovers;
         const auto t = std::chrono::steady_clock::now();
@@ -161,8 +173,28 @@ private:
             if (counted_.insert(kept[i].filename().string()).second) ++checkedComplete;
     }
 
+    // Every 100 sessions, the resident megabytes of each mapping (library, [heap], [anon]) are added to a CSV,
+    // rewritten whole each time, so that a climb in RSS can be traced to what holds it while the run goes on.
+    void writeMappings(const Sample& x) {
+        for (const auto& [name, megabytes] : residentByMapping()) {
+            if (megabytes < 0.05) continue;
+            char row[64];
+            std::snprintf(row, sizeof row, "%zu,%d,%.2f,", samples.size(), x.quiet ? 1 : 0, megabytes);
+            std::string quoted = "\"";
+            for (char c : name) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+            mappingRows_ += row + quoted + "\"\n";
+        }
+        try {
+            writeFileAtomically(mappingsCsv_, "session,quiet,rss_mb,mapping\n" + mappingRows_);
+        } catch (const std::exception& e) {
+            std::printf("soak: mappings not written: %s\n", e.what());
+        }
+    }
+
     VisitorScript& visitor_;
     fs::path sessions_;
+    fs::path mappingsCsv_;
+    std::string mappingRows_;
     ScreenId last_ = ScreenId::Attract;
     std::set<std::string> counted_;
     std::map<std::string, std::chrono::steady_clock::time_point> pendingBefore_;  // pending entry -> first seen
@@ -211,7 +243,9 @@ int main(int argc, char** argv) {
     const BoothConfig config = reliability::fastSimBooth(reliability::syntheticVisitorFolder(work), sessionsDir);
 
     RandomVisitor visitor(RandomVisitorOptions{seed});
-    SoakProbe probe(visitor, sessionsDir);
+    fs::path mappingsCsv;
+    if (!samplesCsv.empty()) mappingsCsv = fs::path(samplesCsv).replace_extension(".mappings.csv");
+    SoakProbe probe(visitor, sessionsDir, mappingsCsv);
     int crashes = 0, ended = 0, kept = 0;
     const auto t0 = std::chrono::steady_clock::now();
     // A crash (an exception out of the kiosk) is counted and the booth started again, as systemd would.
@@ -305,12 +339,15 @@ int main(int argc, char** argv) {
                 last.threads, minThreads, maxThreads);
     if (!samplesCsv.empty()) {
         // Every sample, for plotting or another estimator (written whole or not at all).
-        std::string csv = "session,quiet,rss_mb,heap_in_use_mb,heap_free_mb,open_files,threads\n";
+        std::string csv = "session,quiet,rss_mb,heap_in_use_mb,heap_free_mb,open_files,threads,rss_anon_mb,"
+                          "rss_file_mb,rss_brk_heap_mb,rss_anon_mappings_mb\n";
         for (std::size_t i = 0; i < s.size(); ++i) {
-            char row[160];
-            std::snprintf(row, sizeof row, "%zu,%d,%.2f,%.2f,%.2f,%d,%d\n", i + 1, s[i].quiet ? 1 : 0,
-                          s[i].process.rssMegabytes, s[i].heapInUseMegabytes, s[i].heapFreeMegabytes,
-                          s[i].process.openFiles, s[i].process.threads);
+            char row[240];
+            std::snprintf(row, sizeof row, "%zu,%d,%.2f,%.2f,%.2f,%d,%d,%.2f,%.2f,%.2f,%.2f\n", i + 1,
+                          s[i].quiet ? 1 : 0, s[i].process.rssMegabytes, s[i].heapInUseMegabytes,
+                          s[i].heapFreeMegabytes, s[i].process.openFiles, s[i].process.threads,
+                          s[i].process.anonRssMegabytes, s[i].process.fileRssMegabytes, s[i].brkHeapMegabytes,
+                          s[i].anonOtherMegabytes);
             csv += row;
         }
         try {
