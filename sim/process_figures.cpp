@@ -31,6 +31,20 @@ ProcessFigures readProcessFigures() {
     return f;
 }
 
+namespace {
+
+// What an anonymous mapping most likely holds: glibc's thread arenas are heaps aligned to their 64 MB maximum
+// size; executable ones are code compiled at run time (llvmpipe's shaders); the rest are blocks above the mmap
+// threshold (images), thread stacks and the drivers' own mappings.
+std::string anonymousKind(const std::string& range, const std::string& perms) {
+    const unsigned long long start = std::stoull(range.substr(0, range.find('-')), nullptr, 16);
+    if (perms.find('x') != std::string::npos) return "[anon: code]";
+    if (start % (64ULL << 20) == 0) return "[anon: arena]";
+    return "[anon]";
+}
+
+}  // namespace
+
 std::map<std::string, double> residentByMapping() {
     std::map<std::string, double> resident;
     std::ifstream smaps("/proc/self/smaps");
@@ -44,7 +58,7 @@ std::map<std::string, double> residentByMapping() {
             std::string range, perms, offset, dev, inode, path;
             header >> range >> perms >> offset >> dev >> inode;
             std::getline(header >> std::ws, path);
-            name = path.empty() ? "[anon]" : path;
+            name = path.empty() ? anonymousKind(range, perms) : path;
         } else if (line.compare(0, 4, "Rss:") == 0) {
             resident[name] += std::stod(line.substr(4)) / 1024.0;
         }

@@ -19,8 +19,9 @@ struct ProcessFigures {
 ProcessFigures readProcessFigures();
 
 // Resident megabytes per mapping name from /proc/self/smaps, summed over the mappings of each name: a library's
-// path, "[heap]" (the brk heap: glibc's main arena), "[stack]", and "[anon]" for the anonymous mappings (other
-// arenas, large blocks, JIT code). Where a slow climb of VmRSS comes from. Empty when smaps cannot be read.
+// path, "[heap]" (the brk heap: glibc's main arena), "[stack]", and for anonymous mappings "[anon: arena]" (glibc's
+// other arenas), "[anon: code]" (code compiled at run time) and "[anon]" (large blocks, stacks, drivers' buffers).
+// Where a slow climb of VmRSS comes from. Empty when smaps cannot be read.
 std::map<std::string, double> residentByMapping();
 
 }  // namespace avatarbooth

@@ -1,10 +1,9 @@
-// Photo reading: check the file and its header first, then let OpenCV decode it.
+// Photo reading: check the file and its header first, then decode it (common/image_codec).
 #include "common/image_io.h"
 
 #include "common/error.h"
+#include "common/image_codec.h"
 #include "common/image_header.h"
-
-#include <opencv2/imgcodecs.hpp>
 
 #include <fstream>
 #include <iterator>
@@ -23,11 +22,13 @@ namespace {
 }  // namespace
 
 std::string encodeImage(const cv::Mat& image, const std::string& ext, int jpegQuality) {
-    std::vector<unsigned char> bytes;
-    std::vector<int> params;
-    if (ext == ".jpg") params = {cv::IMWRITE_JPEG_QUALITY, jpegQuality};
-    if (!cv::imencode(ext, image, bytes, params)) throw BoothError(ErrorKind::Internal, "", "could not encode an image as " + ext);
-    return std::string(bytes.begin(), bytes.end());
+    try {
+        if (ext == ".jpg") return encodeJpeg(image, jpegQuality);
+        if (ext == ".png") return encodePng(image);
+    } catch (const std::exception& e) {
+        throw BoothError(ErrorKind::Internal, "", e.what());
+    }
+    throw BoothError(ErrorKind::Internal, "", "could not encode an image as " + ext + " (only .jpg and .png are written)");
 }
 
 cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) {
@@ -69,9 +70,9 @@ cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) {
                       "; at most " + std::to_string(limits.maxPixels / 1'000'000) + " megapixels)");
     cv::Mat image;
     try {
-        image = cv::imdecode(bytes, cv::IMREAD_COLOR);
-    } catch (const cv::Exception& e) {
-        bad(path, std::string("cannot be decoded: ") + e.what());
+        image = decodeImage(bytes.data(), bytes.size());
+    } catch (const ImageDecodeError& e) {
+        bad(path, e.what());
     }
     if (image.empty()) bad(path, "cannot be decoded (corrupt or truncated image)");
     if (static_cast<long long>(image.cols) * image.rows > limits.maxPixels) bad(path, "is too large");

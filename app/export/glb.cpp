@@ -3,8 +3,8 @@
 
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/image_io.h"
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <tiny_gltf.h>
 
@@ -97,9 +97,7 @@ std::string encodeGlb(const Mesh& mesh, const cv::Mat& texture, const std::strin
     material.pbrMetallicRoughness.metallicFactor = 0.0;
     material.pbrMetallicRoughness.roughnessFactor = 0.8;
     if (!texture.empty() && mesh.uvs.size() == n) {
-        std::vector<unsigned char> jpeg;
-        if (!cv::imencode(".jpg", texture, jpeg, {cv::IMWRITE_JPEG_QUALITY, 92}))
-            throw BoothError(ErrorKind::Internal, "", "texture could not be encoded as JPEG");
+        const std::string jpeg = encodeImage(texture, ".jpg", 92);
         tinygltf::Image image;
         image.name = name + "-texture";
         image.mimeType = "image/jpeg";

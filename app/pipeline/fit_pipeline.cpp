@@ -10,7 +10,6 @@
 #include "face/silhouette.h"
 #include "render/previews.h"
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <chrono>

@@ -1,7 +1,8 @@
 // Raw buffer conversions: size checks first, then OpenCV's colour conversions and JPEG decoder.
 #include "drivers/camera/frame_conversion.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "common/image_codec.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -103,9 +104,12 @@ cv::Mat jpegToBgr(const RawFrame& f) {
     if (bytes.size() < 4 || bytes[0] != 0xFF || bytes[1] != 0xD8 || bytes[bytes.size() - 2] != 0xFF ||
         bytes[bytes.size() - 1] != 0xD9)
         return {};  // not a JPEG, or cut short: libjpeg would "decode" it as a half-grey picture
-    const cv::Mat encoded = view(bytes.data(), 1, static_cast<int>(bytes.size()), CV_8UC1, bytes.size());
-    cv::Mat bgr = cv::imdecode(encoded, cv::IMREAD_COLOR);
-    if (bgr.empty()) return {};
+    cv::Mat bgr;
+    try {
+        bgr = decodeImage(bytes.data(), bytes.size());
+    } catch (const ImageDecodeError&) {
+        return {};  // a damaged frame is dropped; the next one follows in 1/30 s
+    }
     if ((f.width && bgr.cols != f.width) || (f.height && bgr.rows != f.height)) return {};
     return bgr;
 }

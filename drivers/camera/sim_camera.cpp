@@ -1,9 +1,9 @@
 // The simulated camera: folder images in, paced noisy preview frames and exact stills out.
 #include "drivers/camera/sim_camera.h"
 
+#include "common/image_codec.h"
 #include "common/image_header.h"
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -73,8 +73,12 @@ cv::Mat readImage(const fs::path& path) {
         badFile(path, "cannot be decoded: its header declares no image size (damaged)");
     if (header.width > kMaxPixels || header.height > kMaxPixels || header.width * header.height > kMaxPixels)
         badFile(path, "is too large (" + std::to_string(header.width) + "x" + std::to_string(header.height) + ")");
-    cv::Mat image = cv::imdecode(bytes, cv::IMREAD_COLOR);
-    if (image.empty()) badFile(path, "cannot be decoded as an image (corrupt data)");
+    cv::Mat image;
+    try {
+        image = decodeImage(bytes.data(), bytes.size());
+    } catch (const ImageDecodeError& e) {
+        badFile(path, e.what());
+    }
     return image;
 }
 

@@ -27,7 +27,7 @@ sysroot_packages=(
   libtinygltf-dev nlohmann-json3-dev libglm-dev
   libegl-dev libgles-dev libopengl-dev libgbm-dev libdrm-dev libx11-dev
   libcli11-dev libspdlog-dev libtomlplusplus-dev libsystemd-dev libgpiod-dev libcamera-dev
-  libfreetype-dev
+  libfreetype-dev libpng-dev libexif-dev libstb-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

@@ -12,9 +12,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
-#include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -30,28 +27,12 @@ void step(const char* what) {
 
 // Resident pages per mapped file, largest first.
 void topLibraries(int count) {
-    std::map<std::string, long> rss;
-    std::ifstream in("/proc/self/smaps");
-    std::string mapping;
-    for (std::string line; std::getline(in, line);) {
-        std::istringstream fields(line);
-        std::string first;
-        fields >> first;
-        if (first.find('-') != std::string::npos && first.back() != ':') {
-            std::string perms, offset, device, inode, path;
-            fields >> perms >> offset >> device >> inode >> path;
-            mapping = path.empty() || path.front() != '/' ? "" : path;
-        } else if (first == "Rss:" && !mapping.empty()) {
-            long kb = 0;
-            fields >> kb;
-            rss[mapping] += kb;
-        }
-    }
-    std::vector<std::pair<long, std::string>> sorted;
-    for (const auto& [path, kb] : rss) sorted.emplace_back(kb, path);
+    std::vector<std::pair<double, std::string>> sorted;
+    for (const auto& [name, megabytes] : residentByMapping())
+        if (!name.empty() && name.front() == '/') sorted.emplace_back(megabytes, name);
     std::sort(sorted.rbegin(), sorted.rend());
     for (int i = 0; i < count && i < static_cast<int>(sorted.size()); ++i)
-        std::printf("memory floor:   %5.1f MB  %s\n", static_cast<double>(sorted[static_cast<std::size_t>(i)].first) / 1024.0,
+        std::printf("memory floor:   %5.1f MB  %s\n", sorted[static_cast<std::size_t>(i)].first,
                     sorted[static_cast<std::size_t>(i)].second.c_str());
 }
 

@@ -42,6 +42,8 @@ struct Sample {
     double heapFreeMegabytes = 0.0;
     double brkHeapMegabytes = 0.0;    // resident in the brk heap (glibc's main arena)
     double anonOtherMegabytes = 0.0;  // resident in anonymous mappings (other arenas, large blocks, llvmpipe's code)
+    double arenaMegabytes = 0.0;      // of those, in glibc's thread arenas
+    double codeMegabytes = 0.0;       // of those, in code compiled at run time (llvmpipe's shaders)
 };
 
 Sample takeSample() {
@@ -56,7 +58,9 @@ Sample takeSample() {
         return it == resident.end() ? 0.0 : it->second;
     };
     s.brkHeapMegabytes = at("[heap]");
-    s.anonOtherMegabytes = at("[anon]");
+    s.arenaMegabytes = at("[anon: arena]");
+    s.codeMegabytes = at("[anon: code]");
+    s.anonOtherMegabytes = at("[anon]") + s.arenaMegabytes + s.codeMegabytes;
     return s;
 }
 
@@ -340,14 +344,14 @@ int main(int argc, char** argv) {
     if (!samplesCsv.empty()) {
         // Every sample, for plotting or another estimator (written whole or not at all).
         std::string csv = "session,quiet,rss_mb,heap_in_use_mb,heap_free_mb,open_files,threads,rss_anon_mb,"
-                          "rss_file_mb,rss_brk_heap_mb,rss_anon_mappings_mb\n";
+                          "rss_file_mb,rss_brk_heap_mb,rss_anon_mappings_mb,rss_arenas_mb,rss_jit_code_mb\n";
         for (std::size_t i = 0; i < s.size(); ++i) {
             char row[240];
-            std::snprintf(row, sizeof row, "%zu,%d,%.2f,%.2f,%.2f,%d,%d,%.2f,%.2f,%.2f,%.2f\n", i + 1,
+            std::snprintf(row, sizeof row, "%zu,%d,%.2f,%.2f,%.2f,%d,%d,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f\n", i + 1,
                           s[i].quiet ? 1 : 0, s[i].process.rssMegabytes, s[i].heapInUseMegabytes,
                           s[i].heapFreeMegabytes, s[i].process.openFiles, s[i].process.threads,
                           s[i].process.anonRssMegabytes, s[i].process.fileRssMegabytes, s[i].brkHeapMegabytes,
-                          s[i].anonOtherMegabytes);
+                          s[i].anonOtherMegabytes, s[i].arenaMegabytes, s[i].codeMegabytes);
             csv += row;
         }
         try {
