@@ -52,6 +52,16 @@ int main(int argc, char** argv) {
         step("+ the base head drawn once (shaders compiled)");
         const LandmarkDetector detector(argc > 1 ? argv[1] : AVATARBOOTH_DEFAULT_DLIB_MODEL);
         step("+ dlib's face detector and 68-point model");
+        {
+            // What the kiosk's session writer adds for its previews: its own GL context (on its own thread in the
+            // kiosk) with the fit's 1024-texel texture, drawn at 512 with 2 samples.
+            MeshRenderer writer(MeshRendererOptions{.maxSamples = 2, .depth = false});
+            writer.upload(head.mesh, cv::Mat(1024, 1024, CV_8UC3, cv::Scalar(90, 120, 200)));
+            cv::Mat preview;
+            writer.renderBgra(RenderCamera::orthographic({0, 0, 400}, {0, 0, 0}, {0, 1, 0}, 1.0, 512, 512), preview);
+            step("+ a second context drawing a 1024 texture at 512");
+        }
+        step("- the second context again");
         std::printf("memory floor: peak %.0f MB; the libraries holding the most pages:\n",
                     readProcessFigures().peakRssMegabytes);
         topLibraries(6);
