@@ -73,6 +73,7 @@ TEST(BadInputFiles, EveryPhotoSeedLoadsOrGivesAClearError) {
         {"zero_byte", "empty"},
         {"not_an_image.txt", "not a JPEG or PNG"},
         {"jpeg_magic_only.jpg", "truncated"},
+        {"pnm_no_pixels.ppm", "PNM data cannot be decoded"},  // found by fuzz_photo: stb_image gave no pixels
     };
     int seen = 0;
     for (const auto& entry : fs::directory_iterator(corpus("photo"))) {
