@@ -1,4 +1,5 @@
-// Raw buffer conversions: size checks first, then OpenCV's colour conversions and JPEG decoder.
+// Raw buffer conversions: size checks first, then OpenCV's colour conversions and the JPEG decoder of
+// common/image_codec (libjpeg-turbo).
 #include "drivers/camera/frame_conversion.h"
 
 #include "common/image_codec.h"
