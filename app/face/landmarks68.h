@@ -22,7 +22,8 @@ struct FaceLandmarks {
 
 class LandmarkDetector {
 public:
-    // Loads dlib's HOG face detector and the shape predictor model (about 100 MB, 1-2 s): do it once.
+    // Loads dlib's HOG face detector and the shape predictor model (a 100 MB file, held in 33 MB; 1-2 s): do it
+    // once.
     // Throws BoothError(BadConfig) naming the model file when it is missing or unreadable.
     explicit LandmarkDetector(const std::filesystem::path& shapePredictorModel);
     ~LandmarkDetector();

@@ -1,0 +1,63 @@
+// The 68-point landmarks of one face: dlib's shape predictor (float leaves, as Debian's model file holds them)
+// against face/quantized_shape_predictor (16-bit leaves, what the booth runs), on a FRMDB front photo, plus the
+// memory each holds. Prints figures; never fails on speed.
+#include "common/image_io.h"
+#include "face/landmarks68.h"
+#include "face/quantized_shape_predictor.h"
+#include "test_paths.h"
+
+#include <benchmark/benchmark.h>
+#include <dlib/image_processing.h>
+#include <dlib/opencv/cv_image.h>
+#include <opencv2/imgproc.hpp>
+
+#include <cstdio>
+#include <memory>
+
+using namespace avatarbooth;
+
+namespace {
+
+struct Face {
+    cv::Mat grey;
+    cv::Rect box;
+};
+
+const Face& face() {
+    static const Face f = [] {
+        Face x;
+        const cv::Mat photo = readPhoto(test::sharedData() / "frmdb" / "001" / "Img_33.jpg");
+        cv::cvtColor(photo, x.grey, cv::COLOR_BGR2GRAY);
+        x.box = LandmarkDetector(AVATARBOOTH_DEFAULT_DLIB_MODEL).detectFaces(photo).at(0);
+        return x;
+    }();
+    return f;
+}
+
+void BM_DlibShapePredictor(benchmark::State& state) {
+    static const auto predictor = [] {
+        auto p = std::make_unique<dlib::shape_predictor>();
+        dlib::deserialize(AVATARBOOTH_DEFAULT_DLIB_MODEL) >> *p;
+        return p;
+    }();
+    const Face& f = face();
+    const dlib::cv_image<unsigned char> image(f.grey);
+    const dlib::rectangle box(f.box.x, f.box.y, f.box.x + f.box.width - 1, f.box.y + f.box.height - 1);
+    for (auto _ : state) benchmark::DoNotOptimize((*predictor)(image, box));
+    // Its leaves alone (leaves x 2 coordinates per part x 4 bytes).
+    state.counters["model_MB"] =
+        static_cast<double>(predictor->num_features() * predictor->num_parts() * 2 * sizeof(float)) / (1024.0 * 1024.0);
+}
+
+void BM_QuantizedShapePredictor(benchmark::State& state) {
+    static const QuantizedShapePredictor predictor(AVATARBOOTH_DEFAULT_DLIB_MODEL);
+    const Face& f = face();
+    for (auto _ : state) benchmark::DoNotOptimize(predictor.predict(f.grey, f.box));
+    state.counters["model_MB"] = static_cast<double>(predictor.modelBytes()) / (1024.0 * 1024.0);
+}
+
+}  // namespace
+
+BENCHMARK(BM_DlibShapePredictor)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QuantizedShapePredictor)->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();
