@@ -540,8 +540,7 @@ void writeScreenshot(const fs::path& dir, int index, const ScreenModel& screen, 
 
 bool kioskLeftAThreadRunning() { return FitWorker::threadLeftRunning.load(); }
 
-KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
-    const auto startup = std::chrono::steady_clock::now();
+void tuneAllocatorForKiosk() {
     // glibc gives each new thread's allocations their own arena (up to 8 per core); with the fit, writer, preview
     // and llvmpipe threads each keeping freed images in its own, the peak RSS of a session measured 43 MB higher
     // (425 against 382 MB) than with two arenas shared by all.
@@ -555,6 +554,11 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     // pinned by small blocks between the freed images), the peak of a session is 9 MB lower, and the frame rates
     // did not change measurably (tests/reliability/soak.cpp; README, Memory).
     mallopt(M_MMAP_THRESHOLD, 128 << 10);
+}
+
+KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
+    const auto startup = std::chrono::steady_clock::now();
+    tuneAllocatorForKiosk();
     setLogSession("");
     // Where the start-up's time goes (`-v`): the booth must be on the attract screen within 2 s of a restart.
     const auto startupStep = [&](const char* what) {

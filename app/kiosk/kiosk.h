@@ -74,6 +74,10 @@ struct KioskReport {
     int styleFrames = 0, characterRenders = 0, toonRenders = 0, stageRenders = 0;
 };
 
+// How the kiosk sets up glibc's allocator (two arenas, a fixed 128 KB mmap threshold: kiosk.cpp says why); runKiosk
+// calls it first. Exposed for the memory benchmarks, which measure the same process.
+void tuneAllocatorForKiosk();
+
 // Runs the booth until options.sessions have ended or options.stop is set. Throws BoothError when a device or the
 // configuration cannot be used at start-up (a camera lost later is waited for, not fatal).
 KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options);

@@ -7,6 +7,7 @@
 #include "drivers/display/headless_egl.h"
 #include "face/landmarks68.h"
 #include "head/base_head.h"
+#include "kiosk/kiosk.h"
 #include "render/mesh_renderer.h"
 #include "sim/process_figures.h"
 
@@ -39,6 +40,7 @@ void topLibraries(int count) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    tuneAllocatorForKiosk();  // as the kiosk does before anything else
     step("libraries loaded");
     {
         HeadlessEglContext context;
