@@ -105,7 +105,8 @@ TEST(QuantizedShapePredictor, LandmarksMatchDlibsOwnPredictorOnRealFaces) {
         if (const auto truth = groundTruth(file); !truth.empty() && box.contains(truth[30])) {
             ++annotated;
             for (unsigned long k = 0; k < 68; ++k) {
-                dlibError += std::hypot(want.part(k).x() - truth[k].x, want.part(k).y() - truth[k].y) / (68.0 * box.width);
+                const cv::Point2d dlibPoint(static_cast<double>(want.part(k).x()), static_cast<double>(want.part(k).y()));
+                dlibError += cv::norm(dlibPoint - truth[k]) / (68.0 * box.width);
                 quantizedError += std::hypot(got[k].x - truth[k].x, got[k].y - truth[k].y) / (68.0 * box.width);
             }
         }
