@@ -109,12 +109,29 @@ SettledRss settledRss(const std::vector<Sample>& s, std::size_t from, std::size_
     return {median, quiet.empty() ? "all " + count + " ends, none quiet" : count + " quiet ends"};
 }
 
+// Every sample as CSV, for plotting or another estimator.
+std::string samplesCsvText(const std::vector<Sample>& s) {
+    std::string csv = "session,quiet,rss_mb,heap_in_use_mb,heap_free_mb,open_files,threads,rss_anon_mb,"
+                      "rss_file_mb,rss_brk_heap_mb,rss_anon_mappings_mb,rss_arenas_mb,rss_jit_code_mb\n";
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        char row[240];
+        std::snprintf(row, sizeof row, "%zu,%d,%.2f,%.2f,%.2f,%d,%d,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f\n", i + 1,
+                      s[i].quiet ? 1 : 0, s[i].process.rssMegabytes, s[i].heapInUseMegabytes, s[i].heapFreeMegabytes,
+                      s[i].process.openFiles, s[i].process.threads, s[i].process.anonRssMegabytes,
+                      s[i].process.fileRssMegabytes, s[i].brkHeapMegabytes, s[i].anonOtherMegabytes,
+                      s[i].arenaMegabytes, s[i].codeMegabytes);
+        csv += row;
+    }
+    return csv;
+}
+
 // Watches the booth through the visitor's eyes: samples the process each time the attract screen comes back,
 // and clears old kept sessions (after checking them) so that thousands of sessions do not fill the disk.
 class SoakProbe final : public VisitorScript {
 public:
-    SoakProbe(VisitorScript& visitor, fs::path sessions, fs::path mappingsCsv)
-        : visitor_(visitor), sessions_(std::move(sessions)), mappingsCsv_(std::move(mappingsCsv)) {}
+    SoakProbe(VisitorScript& visitor, fs::path sessions, fs::path samplesCsv, fs::path mappingsCsv)
+        : visitor_(visitor), sessions_(std::move(sessions)), samplesCsv_(std::move(samplesCsv)),
+          mappingsCsv_(std::move(mappingsCsv)) {}
 
     Action step(const ScreenModel& screen, FlowTime now) override {
         if (screen.id == ScreenId::Attract && last_ != ScreenId::Attract) sessionEnded();
@@ -142,14 +159,24 @@ private:
         // A line every 100 sessions: a run of thousands takes hours, and one stopped early still has its figures.
         if (samples.size() % 100 == 0) {
             const Sample& x = samples.back();
+            // Where RSS settled over these 100 (the drift is measured the same way at the end).
+            const SettledRss settled = settledRss(samples, samples.size() - 100, samples.size());
             std::printf("soak: progress %zu sessions, %.0f s, rss %.1f MB (anon %.1f: brk heap %.1f, mappings %.1f; "
-                        "files %.1f), heap %.1f in use / %.1f free MB, %d open files, %d threads\n",
+                        "files %.1f), settled %.1f MB over the last 100 (median of %s), heap %.1f in use / %.1f "
+                        "free MB, %d open files, %d threads\n",
                         samples.size(), std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(),
                         x.process.rssMegabytes, x.process.anonRssMegabytes, x.brkHeapMegabytes, x.anonOtherMegabytes,
-                        x.process.fileRssMegabytes, x.heapInUseMegabytes, x.heapFreeMegabytes, x.process.openFiles,
-                        x.process.threads);
+                        x.process.fileRssMegabytes, settled.megabytes, settled.over.c_str(), x.heapInUseMegabytes,
+                        x.heapFreeMegabytes, x.process.openFiles, x.process.threads);
             std::fflush(stdout);
             if (!mappingsCsv_.empty()) writeMappings(x);
+            if (!samplesCsv_.empty()) {  // so far: a run stopped early still leaves its samples
+                try {
+                    writeFileAtomically(samplesCsv_, samplesCsvText(samples));
+                } catch (const std::exception& e) {
+                    std::printf("soak: samples not written: %s\n", e.what());
+                }
+            }
         }
         leftoversSeen += check.leftovers;
         const auto t = std::chrono::steady_clock::now();
@@ -197,6 +224,7 @@ private:
 
     VisitorScript& visitor_;
     fs::path sessions_;
+    fs::path samplesCsv_;
     fs::path mappingsCsv_;
     std::string mappingRows_;
     ScreenId last_ = ScreenId::Attract;
@@ -249,7 +277,7 @@ int main(int argc, char** argv) {
     RandomVisitor visitor(RandomVisitorOptions{seed});
     fs::path mappingsCsv;
     if (!samplesCsv.empty()) mappingsCsv = fs::path(samplesCsv).replace_extension(".mappings.csv");
-    SoakProbe probe(visitor, sessionsDir, mappingsCsv);
+    SoakProbe probe(visitor, sessionsDir, samplesCsv, mappingsCsv);
     int crashes = 0, ended = 0, kept = 0;
     const auto t0 = std::chrono::steady_clock::now();
     // A crash (an exception out of the kiosk) is counted and the booth started again, as systemd would.
@@ -342,20 +370,9 @@ int main(int argc, char** argv) {
     std::printf("soak: threads               after warm-up %d, final %d, range %d..%d\n", warm.threads,
                 last.threads, minThreads, maxThreads);
     if (!samplesCsv.empty()) {
-        // Every sample, for plotting or another estimator (written whole or not at all).
-        std::string csv = "session,quiet,rss_mb,heap_in_use_mb,heap_free_mb,open_files,threads,rss_anon_mb,"
-                          "rss_file_mb,rss_brk_heap_mb,rss_anon_mappings_mb,rss_arenas_mb,rss_jit_code_mb\n";
-        for (std::size_t i = 0; i < s.size(); ++i) {
-            char row[240];
-            std::snprintf(row, sizeof row, "%zu,%d,%.2f,%.2f,%.2f,%d,%d,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f\n", i + 1,
-                          s[i].quiet ? 1 : 0, s[i].process.rssMegabytes, s[i].heapInUseMegabytes,
-                          s[i].heapFreeMegabytes, s[i].process.openFiles, s[i].process.threads,
-                          s[i].process.anonRssMegabytes, s[i].process.fileRssMegabytes, s[i].brkHeapMegabytes,
-                          s[i].anonOtherMegabytes, s[i].arenaMegabytes, s[i].codeMegabytes);
-            csv += row;
-        }
+        // Every sample (written whole or not at all; also every 100 sessions while the run goes on).
         try {
-            writeFileAtomically(samplesCsv, csv);
+            writeFileAtomically(samplesCsv, samplesCsvText(s));
             std::printf("soak: samples               %s\n", samplesCsv.c_str());
         } catch (const std::exception& e) {
             std::printf("soak: samples               not written: %s\n", e.what());
