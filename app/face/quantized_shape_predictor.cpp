@@ -39,7 +39,9 @@ struct QuantizedShapePredictor::Model {
     std::vector<Tree> trees;
     std::vector<QuantizedSplit> splits;
     // Leaf l's vector is scales[l] * leaves[l * dims .. (l + 1) * dims): each leaf scaled to its own largest
-    // value, so its rounding error is at most 1/65534 of that (a 300-pixel face: well under 0.01 px in all).
+    // value, so its rounding error is at most 1/65534 of that. Summed over the trees that moves the shape by about
+    // 1e-5 of the face box, which now and then rounds a point to the next pixel or sends a later tree down the
+    // other branch (tests/data: mean 0.09 px from dlib's, at most 2 px).
     std::vector<float> scales;
     std::vector<std::int16_t> leaves;
     std::size_t dims = 0;  // 2 x parts

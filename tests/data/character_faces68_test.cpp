@@ -4,6 +4,7 @@
 // same ratios. Overlays land in the work folder for a person to look at.
 #include "character/proportions.h"
 #include "common/image_io.h"
+#include "ibug_pts.h"
 #include "face/silhouette.h"
 #include "test_paths.h"
 
@@ -33,22 +34,11 @@ const Photo kPhotos[] = {
     // only, and on a turned face the far side's outline lies inside the eye it hides.
 };
 
-// iBUG .pts (1-based pixel coordinates) -> 0-based (x, y).
+// The hand-placed points (test::readIbugPoints), each file expected to hold all 68.
 std::array<cv::Point2d, 68> readLandmarks(const fs::path& file) {
-    std::array<cv::Point2d, 68> p{};
-    std::ifstream in(file);
-    std::string line;
-    std::size_t k = 0;
-    bool inBlock = false;
-    while (std::getline(in, line) && k < 68) {
-        if (line.find('{') != std::string::npos) { inBlock = true; continue; }
-        if (!inBlock) continue;
-        std::istringstream s(line);
-        double x = 0.0, y = 0.0;
-        if (s >> x >> y) p[k++] = {x - 1.0, y - 1.0};
-    }
-    EXPECT_EQ(k, 68u) << file;
-    return p;
+    const auto points = test::readIbugPoints(file);
+    EXPECT_TRUE(points.has_value()) << file;
+    return points.value_or(std::array<cv::Point2d, 68>{});
 }
 
 double dot(cv::Point2d a, cv::Point2d b) { return a.x * b.x + a.y * b.y; }

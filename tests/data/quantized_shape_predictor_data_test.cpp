@@ -4,6 +4,7 @@
 #include "common/image_io.h"
 #include "face/landmarks68.h"
 #include "face/quantized_shape_predictor.h"
+#include "ibug_pts.h"
 #include "test_paths.h"
 
 #include <dlib/image_processing.h>
@@ -44,23 +45,6 @@ std::vector<fs::path> frontalPhotos() {
     return photos;
 }
 
-// The 68 hand-placed points of a 300-W style .pts file next to a photo (empty when there is none).
-std::vector<cv::Point2d> groundTruth(const fs::path& photo) {
-    std::ifstream in(fs::path(photo).replace_extension(".pts"));
-    std::vector<cv::Point2d> points;
-    std::string line;
-    bool inside = false;
-    while (std::getline(in, line)) {
-        if (line.rfind("{", 0) == 0) inside = true;
-        else if (line.rfind("}", 0) == 0) break;
-        else if (inside) {
-            double x = 0, y = 0;
-            if (std::sscanf(line.c_str(), "%lf %lf", &x, &y) == 2) points.emplace_back(x, y);
-        }
-    }
-    return points.size() == 68 ? points : std::vector<cv::Point2d>{};
-}
-
 }  // namespace
 
 TEST(QuantizedShapePredictor, LandmarksMatchDlibsOwnPredictorOnRealFaces) {
@@ -78,9 +62,10 @@ TEST(QuantizedShapePredictor, LandmarksMatchDlibsOwnPredictorOnRealFaces) {
     int photos = 0, points = 0, identical = 0, annotated = 0;
     double worst = 0.0, sum = 0.0, dlibError = 0.0, quantizedError = 0.0;
     for (const fs::path& file : frontalPhotos()) {
+        const cv::Mat photo = readPhoto(file);
         cv::Mat grey;
-        cv::cvtColor(readPhoto(file), grey, cv::COLOR_BGR2GRAY);
-        const std::vector<cv::Rect> boxes = faces.detectFaces(readPhoto(file));
+        cv::cvtColor(photo, grey, cv::COLOR_BGR2GRAY);
+        const std::vector<cv::Rect> boxes = faces.detectFaces(photo);
         if (boxes.empty()) continue;
         ++photos;
         const cv::Rect& box = boxes.front();
@@ -102,12 +87,13 @@ TEST(QuantizedShapePredictor, LandmarksMatchDlibsOwnPredictorOnRealFaces) {
         // from a pixel boundary the other way, and (rarely) to send a later tree down another branch.
         EXPECT_LE(photoWorst, 2.3) << file;
         // (Where the photo holds several faces, the hand-placed points may be another's than the largest.)
-        if (const auto truth = groundTruth(file); !truth.empty() && box.contains(truth[30])) {
+        const auto truth = test::readIbugPoints(fs::path(file).replace_extension(".pts"));
+        if (truth && box.contains(cv::Point((*truth)[30]))) {
             ++annotated;
             for (unsigned long k = 0; k < 68; ++k) {
                 const cv::Point2d dlibPoint(static_cast<double>(want.part(k).x()), static_cast<double>(want.part(k).y()));
-                dlibError += cv::norm(dlibPoint - truth[k]) / (68.0 * box.width);
-                quantizedError += std::hypot(got[k].x - truth[k].x, got[k].y - truth[k].y) / (68.0 * box.width);
+                dlibError += cv::norm(dlibPoint - (*truth)[k]) / (68.0 * box.width);
+                quantizedError += cv::norm(cv::Point2d(got[k]) - (*truth)[k]) / (68.0 * box.width);
             }
         }
     }
