@@ -34,7 +34,7 @@ std::string encodeImage(const cv::Mat& image, const std::string& ext, int jpegQu
 cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) {
     std::error_code ec;
     if (!fs::exists(path, ec)) bad(path, "file not found");
-    if (!fs::is_regular_file(path, ec)) bad(path, "is not a regular file");
+    if (!fs::is_regular_file(path, ec)) bad(path, "is not a regular file (a folder with an image's name?)");
     std::ifstream in(path, std::ios::binary);
     if (!in) bad(path, "cannot be opened (permissions?)");
     const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -1,16 +1,13 @@
 // The simulated camera: folder images in, paced noisy preview frames and exact stills out.
 #include "drivers/camera/sim_camera.h"
 
-#include "common/image_codec.h"
-#include "common/image_header.h"
+#include "common/image_io.h"
 
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <vector>
 
 namespace avatarbooth {
@@ -19,9 +16,6 @@ namespace fs = std::filesystem;
 namespace {
 
 const cv::Scalar kNeutralBackdrop(160, 160, 160);
-// The largest recorded photo replayed (as common/image_io's PhotoLimits: a 24-megapixel still is the largest a
-// booth camera makes).
-constexpr std::int64_t kMaxPixels = 40'000'000;
 
 std::string lower(std::string s) {
     for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -46,40 +40,6 @@ fs::path findImage(const fs::path& folder, const std::string& stem) {
                               "); keep one");
     }
     return found.empty() ? fs::path() : found[0];
-}
-
-bool endsWith(const std::vector<unsigned char>& b, std::initializer_list<unsigned char> tail) {
-    return b.size() >= tail.size() && std::equal(tail.begin(), tail.end(), b.end() - static_cast<long>(tail.size()));
-}
-
-// Reads a JPEG or PNG, refusing truncated files (OpenCV would decode them with a grey lower part).
-cv::Mat readImage(const fs::path& path) {
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) badFile(path, "is not a regular file (a folder with an image's name?)");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) badFile(path, "cannot be read");
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (bytes.empty()) badFile(path, "is empty");
-    const bool jpeg = bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
-    const bool png = bytes.size() >= 8 && bytes[0] == 0x89 && bytes[1] == 'P' && bytes[2] == 'N' && bytes[3] == 'G';
-    if (!jpeg && !png) badFile(path, "is not a JPEG or PNG image");
-    auto end = bytes;
-    while (jpeg && !end.empty() && end.back() == 0) end.pop_back();
-    if (jpeg ? !endsWith(end, {0xFF, 0xD9}) : !endsWith(bytes, {'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82}))
-        badFile(path, "is truncated (the image's end marker is missing)");
-    // A small file may declare a huge image: refuse it before the decoder allocates for it.
-    const ImageHeader header = readImageHeader(bytes.data(), bytes.size());
-    if (header.width <= 0 || header.height <= 0)
-        badFile(path, "cannot be decoded: its header declares no image size (damaged)");
-    if (header.width > kMaxPixels || header.height > kMaxPixels || header.width * header.height > kMaxPixels)
-        badFile(path, "is too large (" + std::to_string(header.width) + "x" + std::to_string(header.height) + ")");
-    cv::Mat image;
-    try {
-        image = decodeImage(bytes.data(), bytes.size());
-    } catch (const ImageDecodeError& e) {
-        badFile(path, e.what());
-    }
-    return image;
 }
 
 // `image` scaled to fit in `size` (aspect kept), centred on the neutral backdrop. An image that already fits is
@@ -172,12 +132,12 @@ SimCamera::SimCamera(SimCameraOptions options, std::shared_ptr<SimCameraControls
         const auto path = findImage(folder, stem);
         if (path.empty())
             badFile(folder / (stem + ".*"), "no " + stem + " photo (" + stem + ".jpg or " + stem + ".png) in the sim camera folder");
-        stills_[static_cast<std::size_t>(scene)] = readImage(path);
+        stills_[static_cast<std::size_t>(scene)] = readPhoto(path);
     }
     const auto& front = stills_[static_cast<std::size_t>(SimScene::Front)];
     const auto background = findImage(folder, "background");
     stills_[static_cast<std::size_t>(SimScene::Empty)] =
-        background.empty() ? cv::Mat(front.size(), CV_8UC3, kNeutralBackdrop) : readImage(background);
+        background.empty() ? cv::Mat(front.size(), CV_8UC3, kNeutralBackdrop) : readPhoto(background);
 
     const double scale = std::min({1.0, static_cast<double>(options_.previewWidth) / front.cols,
                                    static_cast<double>(options_.previewHeight) / front.rows});

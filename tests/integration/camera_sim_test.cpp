@@ -320,14 +320,14 @@ TEST(CameraSim, MissingOrBrokenPhotosNameTheFile) {
     std::vector<unsigned char> jpeg;
     cv::imencode(".jpg", photo, jpeg);
     writeBytes(folder / "front.jpg", std::string(jpeg.begin(), jpeg.begin() + static_cast<long>(jpeg.size() / 2)));
-    expectBadInput(folder, "front.jpg", "is truncated");
+    expectBadInput(folder, "front.jpg", "truncated JPEG");
 
     folder = flatFolder("camera_sim_garbled_front");
     fs::remove(folder / "front.png");
     std::string garbled(jpeg.begin(), jpeg.end());
     std::fill(garbled.begin() + 4, garbled.end() - 2, '\x11');
     writeBytes(folder / "front.jpg", garbled);
-    expectBadInput(folder, "front.jpg", "cannot be decoded");
+    expectBadInput(folder, "front.jpg", "damaged JPEG");
 
     folder = flatFolder("camera_sim_empty_background");
     writeBytes(folder / "background.png", "");
