@@ -10,6 +10,7 @@
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/image_io.h"
+#include "common/recent_timings.h"
 #include "drivers/camera/camera_factory.h"
 #include "drivers/camera/reopening_camera.h"
 #include "drivers/display/display_factory.h"
@@ -513,12 +514,6 @@ std::string newSessionId() {
     return id;
 }
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-}
-
 // replace: the screen's picture again, over the one written before under this index.
 void writeScreenshot(const fs::path& dir, int index, const ScreenModel& screen, const cv::Mat& frame,
                      KioskReport& report, bool replace = false) {
@@ -682,8 +677,8 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     // Benchmark figures.
     int guideFrames = 0, analyses = 0;
     double guideSeconds = 0.0;
-    std::vector<double> revealFrameSeconds, captureToReveal, revealRenderSeconds, revealComposeSeconds,
-        revealPresentSeconds;
+    // (The most recent frames' times: the booth runs for weeks, and a list of every frame grew without end.)
+    RecentTimings revealFrameSeconds, captureToReveal, revealRenderSeconds, revealComposeSeconds, revealPresentSeconds;
     // (Plain time points with a flag: gcc 12 takes optional<time_point> for maybe-uninitialised here.)
     std::chrono::steady_clock::time_point sideTakenAt{}, lastGuideFrame{};
     bool sideTaken = false, inGuide = false;
@@ -1089,12 +1084,12 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
             inGuide = false;
         }
         if (screen.id == ScreenId::Reveal && !inputs.avatar.empty()) {
-            revealFrameSeconds.push_back(Seconds(drawEnd - drawStart).count());
-            if (rendered) revealRenderSeconds.push_back(Seconds(renderEnd - drawStart).count());
-            revealComposeSeconds.push_back(Seconds(composeEnd - renderEnd).count());
-            revealPresentSeconds.push_back(Seconds(drawEnd - composeEnd).count());
+            revealFrameSeconds.add(Seconds(drawEnd - drawStart).count());
+            if (rendered) revealRenderSeconds.add(Seconds(renderEnd - drawStart).count());
+            revealComposeSeconds.add(Seconds(composeEnd - renderEnd).count());
+            revealPresentSeconds.add(Seconds(drawEnd - composeEnd).count());
             if (sideTaken) {
-                captureToReveal.push_back(Seconds(drawEnd - sideTakenAt).count());
+                captureToReveal.add(Seconds(drawEnd - sideTakenAt).count());
                 sideTaken = false;
             }
         }
@@ -1157,8 +1152,8 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     watchdog.reset();
     report.guideFramesPerSecond = guideSeconds > 0.0 ? guideFrames / guideSeconds : 0.0;
     report.analysesPerSecond = guideSeconds > 0.0 ? analyses / guideSeconds : 0.0;
-    report.sideCaptureToRevealSeconds = median(captureToReveal);
-    report.revealFrameMilliseconds = 1000.0 * median(revealFrameSeconds);
+    report.sideCaptureToRevealSeconds = captureToReveal.median();
+    report.revealFrameMilliseconds = 1000.0 * revealFrameSeconds.median();
     const StyleFigures figures = styles->figures();
     report.characterFrameMilliseconds = figures.characterMs;
     report.toonFrameMilliseconds = figures.toonMs;
@@ -1168,13 +1163,12 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
     report.characterRenders = figures.characterRenders;
     report.toonRenders = figures.toonRenders;
     report.stageRenders = figures.stageRenders;
-    report.revealSlowestFrameMilliseconds =
-        revealFrameSeconds.empty() ? 0.0 : 1000.0 * *std::max_element(revealFrameSeconds.begin(), revealFrameSeconds.end());
-    report.revealRenderMilliseconds = 1000.0 * median(revealRenderSeconds);
-    report.revealComposeMilliseconds = 1000.0 * median(revealComposeSeconds);
-    report.revealPresentMilliseconds = 1000.0 * median(revealPresentSeconds);
+    report.revealSlowestFrameMilliseconds = 1000.0 * revealFrameSeconds.slowest();
+    report.revealRenderMilliseconds = 1000.0 * revealRenderSeconds.median();
+    report.revealComposeMilliseconds = 1000.0 * revealComposeSeconds.median();
+    report.revealPresentMilliseconds = 1000.0 * revealPresentSeconds.median();
     report.revealRenderedShare = revealFrameSeconds.empty() ? 0.0
-        : static_cast<double>(revealRenderSeconds.size()) / static_cast<double>(revealFrameSeconds.size());
+        : static_cast<double>(revealRenderSeconds.count()) / static_cast<double>(revealFrameSeconds.count());
     report.avatarTriangles = stage.triangleCount();
     report.avatarSamples = stage.samples();
     rusage usage{};

@@ -5,6 +5,7 @@
 #include "kiosk/avatar_stage.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/recent_timings.h"
 #include "face/profile.h"
 #include "pipeline/fit_pipeline.h"
 #include "render/mesh_renderer.h"
@@ -30,17 +31,6 @@ using Clock = std::chrono::steady_clock;
 // leaves room around it for the turn.
 const cv::Size kToonSize(400, 440);
 constexpr double kToonUnitsPerPixel = 1.0;
-
-double median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-}
-
-void remember(std::vector<double>& v, double x) {
-    if (v.size() >= 2000) v.erase(v.begin(), v.begin() + 1000);  // the recent frames are the ones that matter
-    v.push_back(x);
-}
 
 cv::Mat withAlpha(const cv::Mat& bgr, const cv::Mat& mask) {
     cv::Mat channels[4];
@@ -208,7 +198,7 @@ struct RevealStyles::Impl {
     std::unique_ptr<stage::StageView> stage;
     HeadlessEglContext* context = nullptr;  // shared with the kiosk's other offscreen renders (null: their own)
 
-    std::vector<double> characterMs, toonMs, stageMs;
+    RecentTimings characterMs, toonMs, stageMs;  // the recent frames are the ones that matter
     StyleFigures figures;
     std::uint64_t version = 1;
     std::vector<std::pair<std::string, bool>> lastListed;  // the styles the last fill() listed, with an image or not
@@ -228,7 +218,7 @@ struct RevealStyles::Impl {
         const auto t0 = Clock::now();
         characterRenderer->renderBgra(turningHeadCamera(model, centre, extent, size), characterImage);
         characterPose = model;
-        remember(characterMs, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+        characterMs.add(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
         ++figures.characterRenders;
         ++version;
         return characterImage;
@@ -242,7 +232,7 @@ struct RevealStyles::Impl {
         const cv::Mat bgr = toon::renderToon(*toonModel, yaw, kToonSize, kToonUnitsPerPixel, 2, &coverage);
         toonImage = withAlpha(bgr, coverage);
         toonImageYaw = yaw;
-        remember(toonMs, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+        toonMs.add(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
         ++figures.toonRenders;
         ++version;
         return toonImage;
@@ -379,7 +369,7 @@ void RevealStyles::fill(ScreenInputs& in, bool reveal, std::chrono::milliseconds
         // (fill-rate bound) draws a quarter of the pixels on the frames the camera moves.
         in.stage = s.stage->render(elevation, cv::Size(std::max(1, layout.stage.width / 2), std::max(1, layout.stage.height / 2)));
         if (s.stage->renders() != before) {
-            remember(s.stageMs, s.stage->lastRenderMilliseconds());
+            s.stageMs.add(s.stage->lastRenderMilliseconds());
             ++s.figures.stageRenders;
             ++s.version;
         }
@@ -414,9 +404,9 @@ bool RevealStyles::writeToonStrip(const std::filesystem::path& sessionFolder) {
 
 StyleFigures RevealStyles::figures() const {
     StyleFigures f = impl_->figures;
-    f.characterMs = median(impl_->characterMs);
-    f.toonMs = median(impl_->toonMs);
-    f.stageMs = median(impl_->stageMs);
+    f.characterMs = impl_->characterMs.median();
+    f.toonMs = impl_->toonMs.median();
+    f.stageMs = impl_->stageMs.median();
     return f;
 }
 
