@@ -220,6 +220,24 @@ private:
         } catch (const std::exception& e) {
             std::printf("soak: mappings not written: %s\n", e.what());
         }
+        // And glibc's own account of each arena (malloc_info: its heaps' size, the free chunks by size), next to
+        // the CSV: RSS that climbs in an arena while the bytes in use do not is told apart there as free chunks
+        // too small or too scattered to give back, or as heaps added.
+        char* text = nullptr;
+        std::size_t length = 0;
+        if (FILE* out = open_memstream(&text, &length)) {
+            malloc_info(0, out);
+            std::fclose(out);
+            mallocInfo_ += "<at session=\"" + std::to_string(samples.size()) + "\" quiet=\"" + (x.quiet ? "1" : "0") +
+                           "\">\n" + std::string(text, length) + "</at>\n";
+            std::free(text);
+        }
+        try {
+            writeFileAtomically(fs::path(mappingsCsv_).replace_extension("").replace_extension(".malloc_info.xml"),
+                                "<soak>\n" + mallocInfo_ + "</soak>\n");
+        } catch (const std::exception& e) {
+            std::printf("soak: malloc_info not written: %s\n", e.what());
+        }
     }
 
     VisitorScript& visitor_;
@@ -227,6 +245,7 @@ private:
     fs::path samplesCsv_;
     fs::path mappingsCsv_;
     std::string mappingRows_;
+    std::string mallocInfo_;
     ScreenId last_ = ScreenId::Attract;
     std::set<std::string> counted_;
     std::map<std::string, std::chrono::steady_clock::time_point> pendingBefore_;  // pending entry -> first seen
@@ -237,6 +256,10 @@ private:
 }  // namespace
 
 int main(int argc, char** argv) {
+    // The allocator set up as the kiosk's process has it, before anything here starts a thread: glibc fixes its
+    // arena count when threads first allocate, and the synthetic visitor's render below starts llvmpipe's. Set
+    // only later (runKiosk does it again, harmlessly), the soak ran with 7 arenas where `avatarbooth run` has 2.
+    tuneAllocatorForKiosk();
     int sessions = 10, warmup = -1;
     std::uint64_t seed = 1;
     double maxDrift = 5.0;
