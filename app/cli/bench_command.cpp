@@ -3,9 +3,9 @@
 #include "cli/commands.h"
 
 #include "common/image_io.h"
+#include "common/recent_timings.h"
 #include "pipeline/fit_pipeline.h"
 
-#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <iostream>
@@ -30,11 +30,6 @@ std::string loadAverage() {
     return first.empty() ? "unknown" : first;
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v[v.size() / 2];
-}
-
 }  // namespace
 
 void registerBenchCommand(CLI::App& app) {
@@ -52,9 +47,9 @@ void registerBenchCommand(CLI::App& app) {
         const FitPipeline pipeline{FitSettings{}};
         const cv::Mat front = readPhoto(o->inputs.front), side = readPhoto(o->inputs.side);
         const cv::Mat background = o->inputs.background.empty() ? cv::Mat() : readPhoto(o->inputs.background);
-        std::map<std::string, std::vector<double>> times, cpuTimes;
+        std::map<std::string, RecentTimings> times, cpuTimes;  // keeps 2000: every run (at most 1000)
         std::vector<std::string> order;
-        std::vector<double> totals, cpuTotals;
+        RecentTimings totals, cpuTotals;
         for (int i = 0; i < o->runs; ++i) {
             const FitOutcome out = pipeline.fit(front, side, background, o->inputs);
             if (i == 0) {
@@ -63,15 +58,15 @@ void registerBenchCommand(CLI::App& app) {
             }
             double total = 0.0, cpuTotal = 0.0;
             for (const auto& [name, s] : out.stageSeconds) {
-                times[name].push_back(s);
+                times[name].add(s);
                 total += s;
             }
             for (const auto& [name, s] : out.stageCpuSeconds) {
-                cpuTimes[name].push_back(s);
+                cpuTimes[name].add(s);
                 cpuTotal += s;
             }
-            totals.push_back(total);
-            cpuTotals.push_back(cpuTotal);
+            totals.add(total);
+            cpuTotals.add(cpuTotal);
         }
         std::cout << "machine: " << cpuModel() << ", " << std::thread::hardware_concurrency() << " threads\n"
                   << "photos: front " << front.cols << "x" << front.rows << ", side " << side.cols << "x" << side.rows
@@ -81,11 +76,9 @@ void registerBenchCommand(CLI::App& app) {
                   << " (wall times grow with other work on the machine; processor time is the work itself, all threads)\n";
         for (const auto& name : order)
             std::printf("  %-18s median %7.1f ms   worst %7.1f ms   processor %7.1f ms\n", name.c_str(),
-                        1000 * median(times[name]), 1000 * *std::max_element(times[name].begin(), times[name].end()),
-                        1000 * median(cpuTimes[name]));
+                        1000 * times[name].median(), 1000 * times[name].slowest(), 1000 * cpuTimes[name].median());
         std::printf("  %-18s median %7.1f ms   worst %7.1f ms   processor %7.1f ms   (target: under 300 ms)\n",
-                    "whole fit", 1000 * median(totals), 1000 * *std::max_element(totals.begin(), totals.end()),
-                    1000 * median(cpuTotals));
+                    "whole fit", 1000 * totals.median(), 1000 * totals.slowest(), 1000 * cpuTotals.median());
     });
 }
 

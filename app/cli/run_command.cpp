@@ -159,8 +159,8 @@ void registerRunCommand(CLI::App& app) {
         if (kioskLeftAThreadRunning()) endLeavingTheModelLoad(kExitOk);
         if (report.revealFrameMilliseconds > 0.0)
             std::printf("reveal frame parts: avatar render %.1f ms (%zu triangles, %d samples, %.0f%% of the frames "
-                        "render a new pose, the others show the pose held from before), screen %.1f ms, present %.1f ms; slowest "
-                        "frame %.1f ms\n",
+                        "render a new pose, the others show the pose held from before), screen %.1f ms, present "
+                        "%.1f ms; slowest frame %.1f ms\n",
                         report.revealRenderMilliseconds, report.avatarTriangles, report.avatarSamples,
                         100.0 * report.revealRenderedShare, report.revealComposeMilliseconds,
                         report.revealPresentMilliseconds, report.revealSlowestFrameMilliseconds);
