@@ -139,6 +139,8 @@ void registerRunCommand(CLI::App& app) {
         std::cout << report.sessionsEnded << " visitor session(s); kept:";
         for (const auto& code : report.keptCodes) std::cout << " " << code;
         if (report.keptCodes.empty()) std::cout << " none";
+        if (static_cast<std::size_t>(report.sessionsKept) > report.keptCodes.size())
+            std::cout << " (the last " << report.keptCodes.size() << " of " << report.sessionsKept << " kept)";
         std::cout << "\n";
         for (const auto& code : report.keptCodes)
             std::cout << "session " << code << ": " << (report.sessionsDirectory / code).string()

@@ -705,7 +705,9 @@ KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
         try {
             const std::string code = store.keep(folder, std::chrono::system_clock::now());
             spdlog::info("session kept as {}", code);
+            ++report.sessionsKept;
             report.keptCodes.push_back(code);
+            if (report.keptCodes.size() > KioskReport::kKeptCodesListed) report.keptCodes.pop_front();
             events.push_back(SessionSaved{code, now});
             if (job == styleJob && styles->showsToon()) {
                 if (const auto kept = store.find(code)) toonStripFor = *kept;  // its toon strip follows

@@ -11,6 +11,7 @@
 #include "drivers/camera/sim_camera.h"
 
 #include <atomic>
+#include <deque>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -46,7 +47,11 @@ struct KioskOptions {
 
 struct KioskReport {
     int sessionsEnded = 0;                        // visitors who came and went (kept, discarded or walked away)
-    std::vector<std::string> keptCodes;           // the codes of the sessions kept, in order
+    int sessionsKept = 0;                         // of them, the sessions kept
+    // The codes of the most recent kept sessions, oldest first: at most kKeptCodesListed, because a booth left
+    // running for weeks would otherwise grow this list without end (every code is in the sessions folder anyway).
+    static constexpr std::size_t kKeptCodesListed = 1000;
+    std::deque<std::string> keptCodes;
     std::vector<std::filesystem::path> screenshots;  // written, in order
     std::filesystem::path sessionsDirectory;
     std::vector<std::string> devices;             // what was opened, one line each (as logged at start-up)

@@ -151,6 +151,7 @@ TEST(BoothFaults, CameraVanishesMidPreviewAndComesBack) {
     // The session ended (the kiosk counts a return to the attract screen, and stops there before the visitor
     // sees it).
     EXPECT_EQ(report.sessionsEnded, 1);
+    EXPECT_EQ(report.sessionsKept, 1);
 }
 
 TEST(BoothFaults, CameraVanishesMidCaptureAndComesBack) {

@@ -311,7 +311,7 @@ int main(int argc, char** argv) {
         try {
             const KioskReport report = runKiosk(config, options);
             ended += report.sessionsEnded;
-            kept += static_cast<int>(report.keptCodes.size());
+            kept += report.sessionsKept;
         } catch (const std::exception& e) {
             ++crashes;
             std::cerr << "soak: the kiosk stopped with an error: " << e.what() << "\n";
