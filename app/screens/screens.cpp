@@ -602,11 +602,16 @@ void ScreenRenderer::thanks(const ScreenModel& m) {
         drawText(str("thanks.saving"), L.code, static_cast<int>(60 * u), kInk, FontWeight::Bold);
     } else {
         // Letters spaced out a little: a code is read (and copied) one character at a time.
-        std::string spaced;
-        for (char c : m.code) spaced += spaced.empty() ? std::string(1, c) : std::string(" ") + c;
+        std::string spaced, widest;
+        for (char c : m.code) {
+            spaced += spaced.empty() ? std::string(1, c) : std::string(" ") + c;
+            widest += widest.empty() ? "W" : " W";
+        }
+        // Sized so that the widest code of this length fits, so every code shows at one size (rather than one
+        // size per code's width, which would also give the glyph cache a new size for most visitors).
         int px = static_cast<int>(L.code.height * 0.62);
         const int inner = L.code.width - static_cast<int>(48 * u);
-        if (const int w = text_->measure(spaced, px, FontWeight::Bold).width; w > inner) px = px * inner / w;
+        if (const int w = text_->measure(widest, px, FontWeight::Bold).width; w > inner) px = px * inner / w;
         drawText(spaced, L.code, px, kInk, FontWeight::Bold);
     }
     const cv::Rect info(L.middle.x + static_cast<int>(32 * u), L.code.br().y + static_cast<int>(24 * u),

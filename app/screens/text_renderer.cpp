@@ -229,11 +229,19 @@ const TextRenderer::Glyph& TextRenderer::glyph(char32_t cp, int px, FontWeight w
         }
         g.advance26 = slot->advance.x + extra;
     }
+    glyphBytes_ += g.coverage.total();
     return glyphs_.emplace(key, std::move(g)).first->second;
+}
+
+void TextRenderer::boundGlyphCache() {
+    if (glyphBytes_ <= kGlyphCacheBytes) return;
+    glyphs_.clear();
+    glyphBytes_ = 0;
 }
 
 std::vector<TextRenderer::Placed> TextRenderer::layout(const std::u32string& text, int px, FontWeight weight,
                                                        long* width26) {
+    boundGlyphCache();
     std::vector<Placed> out;
     out.reserve(text.size());
     long pen = 0;
@@ -292,6 +300,7 @@ void TextRenderer::draw(cv::Mat& bgr, std::string_view utf8, cv::Point origin, i
 }
 
 std::vector<std::string> TextRenderer::wrap(std::string_view utf8, int px, int maxWidth, FontWeight weight) {
+    boundGlyphCache();
     std::vector<std::string> lines;
     const long max26 = static_cast<long>(maxWidth) * 64;
     const std::u32string all = decodeUtf8(utf8);

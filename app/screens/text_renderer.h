@@ -66,8 +66,14 @@ public:
     std::vector<std::string> wrap(std::string_view utf8, int pixelSize, int maxWidth,
                                   FontWeight weight = FontWeight::Regular);
 
-    // Glyphs rasterised so far (each once per font, size and weight).
+    // Glyphs rasterised and kept (each once per font, size and weight), and the bytes their bitmaps take.
     std::size_t cachedGlyphs() const { return glyphs_.size(); }
+    std::size_t cachedGlyphBytes() const { return glyphBytes_; }
+    // The cache's bound. Text is drawn at sizes that depend on the text (a long line shrunk to fit its box), so
+    // a booth that runs for weeks meets new sizes for ever; a cache that only grew would grow with it. When the
+    // bitmaps pass this, the cache is emptied before the next string is laid out and refills with what the
+    // screens use now: a few hundred kilobytes, so this is reached only by unusual text.
+    static constexpr std::size_t kGlyphCacheBytes = std::size_t{4} << 20;
 
 private:
     struct Face;
@@ -83,11 +89,15 @@ private:
     const Glyph& glyph(char32_t codepoint, int pixelSize, FontWeight weight);
     std::vector<Placed> layout(const std::u32string& text, int pixelSize, FontWeight weight, long* width26);
     void lineMetrics(int pixelSize, FontWeight weight, Metrics& m);
+    // Empties the cache when it is over kGlyphCacheBytes. Called only where a call starts laying out a string:
+    // a layout holds pointers into the cache until its string is drawn.
+    void boundGlyphCache();
 
     void* library_ = nullptr;  // FT_Library
     std::vector<std::unique_ptr<Face>> faces_;
     std::vector<int> regularChain_, boldChain_;  // indices into faces_, in fallback order
     std::unordered_map<std::uint64_t, Glyph> glyphs_;
+    std::size_t glyphBytes_ = 0;  // of the coverage bitmaps in glyphs_
 };
 
 }  // namespace avatarbooth

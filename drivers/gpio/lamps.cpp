@@ -46,6 +46,8 @@ void SimLamps::set(const std::string& name, bool on) {
     if (it == on_.end()) unknownLamp(name, names_);
     if (it->second == on) return;
     it->second = on;
+    if (changes_.size() == kKeptChanges)
+        changes_.erase(changes_.begin(), changes_.begin() + static_cast<std::ptrdiff_t>(kKeptChanges / 2));
     changes_.push_back({name, on, clock_.now()});
 }
 

@@ -330,6 +330,45 @@ TEST(ScreensPixels, CodeGlyphsAreDrawn) {
     EXPECT_NE(cv::countNonZero(inkSaving), cv::countNonZero(ink));
 }
 
+TEST(ScreensPixels, EveryCodeShowsAtOneSizeAndTheWidestFits) {
+    for (const cv::Size screen : {cv::Size(1280, 720), cv::Size(800, 480), cv::Size(480, 800)}) {
+        ScreenRenderer& r = renderer(Language::English, screen);
+        // Inside the code's light box: below and above its rounded corners (radius 28 units; the page around is
+        // dark), and 12 units in from its ends (half the margin the code keeps).
+        const double u = r.layout().unit;
+        const int corner = static_cast<int>(std::ceil(28 * u)) + 2, end = static_cast<int>(std::ceil(12 * u));
+        const cv::Rect box(r.layout().code.x + end, r.layout().code.y + corner, r.layout().code.width - 2 * end,
+                           r.layout().code.height - 2 * corner);
+        // The ink of the code's letters: its bounding box, and how many letters (blobs) it has.
+        const auto inkOf = [&](const std::string& code) {
+            ScreenModel m;
+            m.id = ScreenId::Thanks;
+            m.code = code;
+            cv::Mat ink, labels, stats, centroids;
+            cv::inRange(r.draw(m, {})(box), cv::Scalar(0, 0, 0), cv::Scalar(120, 120, 120), ink);
+            int letters = 0;
+            for (int i = 1, n = cv::connectedComponentsWithStats(ink, labels, stats, centroids); i < n; ++i)
+                letters += stats.at<int>(i, cv::CC_STAT_AREA) > 20;
+            return std::make_pair(cv::boundingRect(ink), letters);
+        };
+        const auto [wide, wideLetters] = inkOf("WWWWWW");
+        const auto [narrow, narrowLetters] = inkOf("EEEEEE");
+        const auto [digits, digitLetters] = inkOf("234567");
+        EXPECT_EQ(wideLetters, 6) << screen;
+        EXPECT_EQ(narrowLetters, 6) << screen;
+        EXPECT_EQ(digitLetters, 6) << screen;
+        // Capitals of one size: the same height, whatever the code's width.
+        EXPECT_EQ(wide.height, narrow.height) << screen;
+        EXPECT_NEAR(digits.height, narrow.height, 2) << screen;  // digits are about as tall as capitals
+        // As big as the box allows: the widest code fills its width, or the letters are a good part of its height.
+        EXPECT_TRUE(wide.width > box.width * 8 / 10 || wide.height > r.layout().code.height / 4)
+            << screen << ": " << wide;
+        // The widest code inside the box, not touching its ends.
+        EXPECT_GT(wide.x, 0) << screen;
+        EXPECT_LT(wide.br().x, box.width) << screen;
+    }
+}
+
 TEST(ScreensPixels, HintTextFollowsTheHint) {
     ScreenRenderer& r = renderer(Language::English, {1280, 720});
     ScreenModel m;

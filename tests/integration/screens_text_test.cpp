@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -200,6 +201,33 @@ TEST(TextRenderer, GlyphsAreCachedOnce) {
     EXPECT_EQ(t.cachedGlyphs(), 6u);  // per weight
     t.measure("a", 41);
     EXPECT_EQ(t.cachedGlyphs(), 7u);  // and per size
+}
+
+TEST(TextRenderer, GlyphCacheStaysUnderItsBoundAndDrawsTheSameAfterEmptying) {
+    TextRenderer t(resolveFonts(), Language::English);
+    const std::string text = "ABCDEFGHJKLMNPQRSTUVWXYZ23456789";  // a session code's alphabet
+    const auto drawAt = [&](TextRenderer& r, int px) {
+        cv::Mat img(px * 2, px * 40, CV_8UC3, cv::Scalar(0, 0, 0));
+        r.draw(img, text, {0, px * 3 / 2}, px, cv::Scalar(255, 255, 255), FontWeight::Bold);
+        return img;
+    };
+    const cv::Mat first = drawAt(t, 120);
+    const std::size_t oneSize = t.cachedGlyphBytes();
+    EXPECT_GT(oneSize, 32u * 50 * 50);  // 32 glyphs of about 90x120 pixels
+    // Every size from 100 to 220 pixels: tens of megabytes of bitmaps without a bound.
+    std::size_t largest = 0, emptied = 0, before = t.cachedGlyphBytes();
+    for (int px = 100; px <= 220; ++px) {
+        drawAt(t, px);
+        largest = std::max(largest, t.cachedGlyphBytes());
+        if (t.cachedGlyphBytes() < before) ++emptied;
+        before = t.cachedGlyphBytes();
+    }
+    EXPECT_GE(emptied, 3u);
+    // Over the bound by at most one string's glyphs (the cache is emptied before a string, never during one).
+    EXPECT_LE(largest, TextRenderer::kGlyphCacheBytes + 32u * 220 * 220);
+    EXPECT_EQ(cv::norm(drawAt(t, 120), first, cv::NORM_INF), 0.0);  // refilled glyphs draw the same
+    TextRenderer fresh(resolveFonts(), Language::English);
+    EXPECT_EQ(cv::norm(drawAt(fresh, 120), first, cv::NORM_INF), 0.0);
 }
 
 TEST(TextRenderer, WrapsEnglishAtSpaces) {

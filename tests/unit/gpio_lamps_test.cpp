@@ -86,6 +86,25 @@ TEST(GpioLamps, DriverRecordsExactlyTheChangesOfAttractThenCapture) {
     EXPECT_FALSE(lamps.isOn("retake"));
 }
 
+TEST(GpioLamps, SimLampsKeepOnlyTheMostRecentChanges) {
+    ManualClock clock(T0);
+    SimLamps lamps({"start"}, clock);
+    // A week of blinking start lamp (2 changes a second) would be a million changes; a booth keeps the last few.
+    const std::size_t n = 3 * SimLamps::kKeptChanges + 5;
+    for (std::size_t i = 0; i < n; ++i) {
+        clock.sleepUntil(T0 + std::chrono::milliseconds(500 * i));
+        lamps.set("start", i % 2 == 0);
+        ASSERT_LE(lamps.changes().size(), SimLamps::kKeptChanges);
+    }
+    const auto& kept = lamps.changes();
+    ASSERT_GE(kept.size(), SimLamps::kKeptChanges / 2);
+    // The newest, in order, ending with the last change made.
+    for (std::size_t k = 0; k < kept.size(); ++k) {
+        const std::size_t i = n - kept.size() + k;
+        EXPECT_EQ(kept[k], (SimLamps::Change{"start", i % 2 == 0, T0 + std::chrono::milliseconds(500 * i)})) << k;
+    }
+}
+
 TEST(GpioLamps, UnknownLampIsAConfigError) {
     ManualClock clock(T0);
     SimLamps lamps({"start"}, clock);
