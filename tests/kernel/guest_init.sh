@@ -4,12 +4,16 @@
 /bin/busybox mkdir -p /sbin /usr/bin /usr/sbin; /bin/busybox --install -s
 mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev
 for a in $(cat /proc/cmdline); do
-  case $a in gscript=*) GS=${a#gscript=};; wdir=*) WD=${a#wdir=};; kroot=*) KR=${a#kroot=};; esac
+  case $a in gscript=*) GS=${a#gscript=};; wdir=*) WD=${a#wdir=};; kroot=*) KR=${a#kroot=};; keeptmp=*) KT=${a#keeptmp=};; esac
 done
 for m in $(cat /mods/order); do insmod /mods/$m; done
 mount -t 9p -o trans=virtio,version=9p2000.L,ro,msize=512000,cache=loose hostroot /host
 mount -t proc proc /host/proc; mount -t sysfs sys /host/sys; mount -t devtmpfs dev /host/dev
-mount -t devpts devpts /host/dev/pts 2>/dev/null; mount -t tmpfs tmp /host/tmp; mount -t tmpfs run /host/run
+mount -t devpts devpts /host/dev/pts 2>/dev/null
+# The guest's own /tmp; folders of the host's /tmp it needs (keeptmp: a checkout there) are bound back over it.
+mkdir -p /hosttmp; mount -o bind /host/tmp /hosttmp
+mount -t tmpfs tmp /host/tmp; mount -t tmpfs run /host/run
+for d in $(echo "$KT" | tr , ' '); do mkdir -p "/host$d" && mount -o bind "/hosttmp${d#/tmp}" "/host$d"; done
 mount -t debugfs debugfs /host/sys/kernel/debug 2>/dev/null
 # The work folder may lie inside the read-only host root: mount it over its own path.
 mount -t 9p -o trans=virtio,version=9p2000.L,msize=512000 work /host$WD

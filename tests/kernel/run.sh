@@ -22,13 +22,21 @@ cat > "$work/guest.sh" <<GUEST
 echo "[guest] running $binary"
 "$binary" --gtest_filter='$filter' --gtest_color=no --gtest_output=xml:"\$W/kernel_tests.xml"
 GUEST
+# The guest mounts a tmpfs of its own on /tmp (the host root is read-only to it), which would hide a checkout
+# under the host's /tmp (a clone made to try the set-up). Such folders are named to the guest, which binds them
+# back from the host's /tmp over its tmpfs.
+keeptmp=""
+for p in "$binary" "$kdir" "$here"; do
+  case "$p" in /tmp/?*) top=/tmp/$(echo "${p#/tmp/}" | cut -d/ -f1)
+    case ",$keeptmp," in *",$top,"*) ;; *) keeptmp=${keeptmp:+$keeptmp,}$top;; esac;; esac
+done
 accel="-accel tcg,thread=multi -cpu max"
 rc=0
 # -nic none: the tests need no network. panic=-1 and -no-reboot turn a guest crash into qemu exiting.
 # debug-threads: the vCPU threads are named ("CPU 0/TCG", ... one per vCPU: multi-threaded TCG) for top -H.
 timeout -k 10 "$limit" qemu-system-x86_64 $accel -name avatarbooth-kernel,debug-threads=on -m 1024 -smp "$(nproc)" -nographic -no-reboot -nic none \
   -kernel "$kdir/vmlinuz" -initrd "$kdir/initrd.img" \
-  -append "console=ttyS0 loglevel=4 panic=-1 edd=off rdinit=/init avatarbooth_kernel_guest=1 wdir=$work kroot=$kdir/kroot gscript=$work/guest.sh" \
+  -append "console=ttyS0 loglevel=4 panic=-1 edd=off rdinit=/init avatarbooth_kernel_guest=1 wdir=$work kroot=$kdir/kroot gscript=$work/guest.sh${keeptmp:+ keeptmp=$keeptmp}" \
   -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap \
   -virtfs local,path="$work",mount_tag=work,security_model=none,multidevs=remap < /dev/null || rc=$?
 if [ "$rc" -ne 0 ]; then echo "kernel tests: qemu failed or timed out after ${limit} s (exit $rc)"; exit 1; fi
