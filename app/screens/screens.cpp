@@ -602,15 +602,26 @@ void ScreenRenderer::thanks(const ScreenModel& m) {
         drawText(str("thanks.saving"), L.code, static_cast<int>(60 * u), kInk, FontWeight::Bold);
     } else {
         // Letters spaced out a little: a code is read (and copied) one character at a time.
+        int px = static_cast<int>(L.code.height * 0.62);
+        const int inner = L.code.width - static_cast<int>(48 * u);
+        if (widestCodeLetterAt_ != px) {
+            int widestWidth = -1;
+            for (char c : kCodeAlphabet) {
+                const int w = text_->measure(std::string(1, c), px, FontWeight::Bold).width;
+                if (w > widestWidth) {
+                    widestWidth = w;
+                    widestCodeLetter_ = c;
+                }
+            }
+            widestCodeLetterAt_ = px;
+        }
         std::string spaced, widest;
         for (char c : m.code) {
             spaced += spaced.empty() ? std::string(1, c) : std::string(" ") + c;
-            widest += widest.empty() ? "W" : " W";
+            widest += widest.empty() ? std::string(1, widestCodeLetter_) : std::string(" ") + widestCodeLetter_;
         }
         // Sized so that the widest code of this length fits, so every code shows at one size (rather than one
         // size per code's width, which would also give the glyph cache a new size for most visitors).
-        int px = static_cast<int>(L.code.height * 0.62);
-        const int inner = L.code.width - static_cast<int>(48 * u);
         if (const int w = text_->measure(widest, px, FontWeight::Bold).width; w > inner) px = px * inner / w;
         drawText(spaced, L.code, px, kInk, FontWeight::Bold);
     }

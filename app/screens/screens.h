@@ -147,6 +147,10 @@ private:
         int width = 0, ascent = 0;
     };
     std::map<std::string, BigText> bigText_;  // the countdown's numbers
+    // The widest letter a session code can have (kCodeAlphabet) in this renderer's bold font at the code's size,
+    // measured the first time a code is shown: the thanks screen sizes every code by it.
+    int widestCodeLetterAt_ = 0;  // the pixel size it was measured at (0: not yet)
+    char widestCodeLetter_ = 0;
     // The reveal without its avatar and banner (background, title, button labels: the same every frame), and what
     // the canvas holds after the last reveal drawn: its avatar version and banner.
     cv::Mat revealLayer_;
