@@ -23,10 +23,10 @@ echo "[guest] running $binary"
 "$binary" --gtest_filter='$filter' --gtest_color=no --gtest_output=xml:"\$W/kernel_tests.xml"
 GUEST
 # The guest mounts a tmpfs of its own on /tmp (the host root is read-only to it), which would hide a checkout
-# under the host's /tmp (a clone made to try the set-up). Such folders are named to the guest, which binds them
-# back from the host's /tmp over its tmpfs.
+# under the host's /tmp (a clone made to try the set-up), and the work folder's mount point with it. Such
+# folders are named to the guest, which binds them back from the host's /tmp over its tmpfs.
 keeptmp=""
-for p in "$binary" "$kdir" "$here"; do
+for p in "$binary" "$kdir" "$here" "$work"; do
   case "$p" in /tmp/?*) top=/tmp/$(echo "${p#/tmp/}" | cut -d/ -f1)
     case ",$keeptmp," in *",$top,"*) ;; *) keeptmp=${keeptmp:+$keeptmp,}$top;; esac;; esac
 done
