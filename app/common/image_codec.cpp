@@ -3,6 +3,8 @@
 // its caller owns, and it returns false when the library jumped back with an error.
 #include "common/image_codec.h"
 
+#include "common/image_header.h"
+
 #include <opencv2/imgproc.hpp>
 
 // The C libraries after the C++ ones: jpeglib.h needs <cstdio>'s FILE and size_t first.
@@ -12,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include <jpeglib.h>
@@ -267,21 +270,96 @@ void checkEncodable(const cv::Mat& image, const char* format) {
                                  " must be 8-bit grey, BGR or BGRA and not empty");
 }
 
-// ---- BMP and PNM (stb_image) ----
+// ---- BMP (stb_image) ----
 
-cv::Mat decodeWithStb(const unsigned char* data, std::size_t size, const char* format) {
-    if (size > static_cast<std::size_t>(INT32_MAX)) throw ImageDecodeError(std::string(format) + ": the file is too large");
+// The bytes an uncompressed (or bit-field) BMP needs by its header, the kinds cameras and editors write; 0 when
+// the header is another kind (stb_image refuses RLE itself) or too short to say.
+std::uint64_t bmpDeclaredBytes(const unsigned char* data, std::size_t size) {
+    using image_header_detail::littleEndian32;
+    if (size < 34 || littleEndian32(data, 14) < 40) return 0;  // not a BITMAPINFOHEADER or later
+    const std::int64_t width = littleEndian32(data, 18), height = std::abs(std::int64_t{littleEndian32(data, 22)});
+    const unsigned bitsPerPixel = data[28] | unsigned{data[29]} << 8;
+    const std::int32_t compression = littleEndian32(data, 30);
+    if ((compression != 0 && compression != 3) || width <= 0 || height == 0 || bitsPerPixel == 0 || bitsPerPixel > 32)
+        return 0;
+    const std::uint64_t rowBytes = (static_cast<std::uint64_t>(width) * bitsPerPixel + 31) / 32 * 4;  // 4-byte rows
+    const auto pixelsAt = static_cast<std::uint32_t>(littleEndian32(data, 10));
+    const auto rows = static_cast<std::uint64_t>(height);
+    if (rows > (UINT64_MAX - pixelsAt) / rowBytes) return UINT64_MAX;  // sides up to 2^31: the product may overflow
+    return pixelsAt + rowBytes * rows;
+}
+
+cv::Mat decodeBmp(const unsigned char* data, std::size_t size) {
+    if (size > static_cast<std::size_t>(INT32_MAX)) throw ImageDecodeError("BMP: the file is too large");
+    // stb_image fills the rows of a BMP cut short with black and says nothing, so the length is checked first.
+    if (const std::uint64_t declared = bmpDeclaredBytes(data, size); declared > size)
+        throw ImageDecodeError("BMP data is truncated: its header declares " + std::to_string(declared) +
+                               " bytes, the file has " + std::to_string(size));
     int width = 0, height = 0, channels = 0;
     unsigned char* rgb = stbi_load_from_memory(data, static_cast<int>(size), &width, &height, &channels, 3);
-    if (rgb == nullptr)
-        throw ImageDecodeError(std::string(format) + " data cannot be decoded: " + stbi_failure_reason());
-    if (width <= 0 || height <= 0) {  // stb_image hands out a picture of no pixels for some damaged PNM headers
+    if (rgb == nullptr) throw ImageDecodeError(std::string("BMP data cannot be decoded: ") + stbi_failure_reason());
+    if (width <= 0 || height <= 0) {
         stbi_image_free(rgb);
-        throw ImageDecodeError(std::string(format) + " data cannot be decoded: its header declares no pixels");
+        throw ImageDecodeError("BMP data cannot be decoded: its header declares no pixels");
     }
     cv::Mat bgr;
     cv::cvtColor(cv::Mat(height, width, CV_8UC3, rgb), bgr, cv::COLOR_RGB2BGR);
     stbi_image_free(rgb);
+    return bgr;
+}
+
+// ---- Binary PNM (P5 grey, P6 colour), read here ----
+// Not with stb_image: Debian bookworm's copy (git 2022-09-08) reads past its buffer when a PNM with more than 8
+// bits a sample (maxval over 255) is turned into three channels (found by fuzz_photo), takes those samples in the
+// machine's byte order instead of PNM's big-endian one, ignores a maxval other than 255, and hands out
+// uninitialised pixels for a file cut short. The format is a text header and raw samples (netpbm's pam(5) and
+// pgm(5) pages), so reading it here takes less code than working around all four.
+// Samples scale to 0-255 by maxval, rounded (a maxval of 15 is not a dark picture); with maxval 65535 the high
+// byte is kept, as for 16-bit PNGs and as imread does. Samples above maxval count as maxval.
+cv::Mat decodePnm(const unsigned char* data, std::size_t size) {
+    using image_header_detail::pnmNumber;
+    const bool colour = data[1] == '6';
+    const auto isSpace = [](unsigned char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
+    std::size_t at = 2;
+    if (at >= size || !isSpace(data[at])) throw ImageDecodeError("PNM data cannot be decoded: no space after its P5/P6");
+    const std::int64_t width = pnmNumber(data, size, at);
+    const std::int64_t height = width >= 0 ? pnmNumber(data, size, at) : -1;
+    const std::int64_t maxval = height >= 0 ? pnmNumber(data, size, at) : -1;
+    if (maxval < 0 || at >= size || !isSpace(data[at]))
+        throw ImageDecodeError("PNM data cannot be decoded: its header (width, height, maxval) is cut short or damaged");
+    ++at;  // exactly one whitespace byte ends the header; the samples start after it
+    if (width <= 0 || height <= 0) throw ImageDecodeError("PNM data cannot be decoded: its header declares no pixels");
+    if (maxval < 1 || maxval > 65535)
+        throw ImageDecodeError("PNM data cannot be decoded: its maxval " + std::to_string(maxval) + " is not 1-65535");
+
+    const std::size_t channels = colour ? 3 : 1, sampleBytes = maxval > 255 ? 2 : 1;
+    const std::size_t left = size - at;
+    // Every pixel takes at least one byte, so each side is at most `left` and the product cannot overflow.
+    const auto w = static_cast<std::uint64_t>(width), h = static_cast<std::uint64_t>(height);
+    if (w > left || h > left || w * h > left / (channels * sampleBytes))
+        throw ImageDecodeError("PNM data is truncated: its header declares " + std::to_string(width) + "x" +
+                               std::to_string(height) + " but only " + std::to_string(left) + " bytes of samples follow");
+
+    // 0..maxval to 0..255, once for every possible sample value (at most 64 Ki entries).
+    std::vector<unsigned char> to8(static_cast<std::size_t>(sampleBytes == 2 ? 65536 : 256));
+    for (std::size_t v = 0; v < to8.size(); ++v) {
+        const std::uint64_t m = static_cast<std::uint64_t>(maxval), s = std::min<std::uint64_t>(v, m);
+        to8[v] = static_cast<unsigned char>(m == 65535 ? s >> 8 : (s * 255 + m / 2) / m);
+    }
+    cv::Mat bgr(static_cast<int>(height), static_cast<int>(width), CV_8UC3);
+    const unsigned char* in = data + at;
+    for (int y = 0; y < bgr.rows; ++y) {
+        auto* out = bgr.ptr<unsigned char>(y);
+        for (int x = 0; x < bgr.cols; ++x, out += 3) {
+            unsigned char rgb[3];
+            for (std::size_t c = 0; c < channels; ++c, in += sampleBytes)
+                rgb[c] = to8[sampleBytes == 2 ? (std::size_t{in[0]} << 8 | in[1]) : in[0]];
+            if (!colour) rgb[1] = rgb[2] = rgb[0];
+            out[0] = rgb[2];
+            out[1] = rgb[1];
+            out[2] = rgb[0];
+        }
+    }
     return bgr;
 }
 
@@ -291,8 +369,8 @@ cv::Mat decodeImage(const unsigned char* data, std::size_t size) {
     static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
     if (size >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF) return decodeJpeg(data, size);
     if (size >= 8 && std::memcmp(data, kPng, 8) == 0) return decodePng(data, size);
-    if (size >= 2 && data[0] == 'B' && data[1] == 'M') return decodeWithStb(data, size, "BMP");
-    if (size >= 2 && data[0] == 'P' && (data[1] == '5' || data[1] == '6')) return decodeWithStb(data, size, "PNM");
+    if (size >= 2 && data[0] == 'B' && data[1] == 'M') return decodeBmp(data, size);
+    if (size >= 2 && data[0] == 'P' && (data[1] == '5' || data[1] == '6')) return decodePnm(data, size);
     if (size >= 2 && data[0] == 'P' && data[1] >= '1' && data[1] <= '4')
         throw ImageDecodeError("is a text or 1-bit PNM (P1-P4); save it as binary PPM (P6), PNG or JPEG");
     throw ImageDecodeError("is not a JPEG, PNG, BMP or PNM image");

@@ -1,4 +1,5 @@
-// Image files to pixels and back: JPEG with libjpeg-turbo, PNG with libpng, BMP and binary PNM with stb_image.
+// Image files to pixels and back: JPEG with libjpeg-turbo, PNG with libpng, BMP with stb_image, binary PNM read
+// here (image_codec.cpp says why).
 //
 // Why not OpenCV's imgcodecs: Debian builds it against GDAL, so linking it loads about a hundred more libraries
 // (GDAL, PROJ, Poppler, HDF5, ...) that hold 37 MB resident in the kiosk for formats a booth never reads. The
@@ -21,8 +22,9 @@ public:
 };
 
 // Decodes a JPEG, PNG, BMP or binary PNM (P5/P6) held in memory to 8-bit BGR (3 channels): grey is replicated,
-// alpha dropped, 16-bit samples keep their high byte, a JPEG's EXIF orientation is applied. The format is taken
-// from the data's first bytes, not from a file name. Throws ImageDecodeError.
+// alpha dropped, 16-bit samples keep their high byte, PNM samples scale by their maxval (a maxval of 15 is not a
+// dark picture), a JPEG's EXIF orientation is applied. The format is taken from the data's first bytes, not from
+// a file name. Throws ImageDecodeError.
 cv::Mat decodeImage(const unsigned char* data, std::size_t size);
 
 // JPEG bytes of an 8-bit grey, BGR or BGRA image (alpha dropped) at `quality` (1-100), 4:2:0 like libjpeg's

@@ -73,7 +73,10 @@ TEST(BadInputFiles, EveryPhotoSeedLoadsOrGivesAClearError) {
         {"zero_byte", "empty"},
         {"not_an_image.txt", "not a JPEG or PNG"},
         {"jpeg_magic_only.jpg", "truncated"},
-        {"pnm_no_pixels.ppm", "PNM data cannot be decoded"},  // found by fuzz_photo: stb_image gave no pixels
+        {"pnm_no_pixels.ppm", "PNM data cannot be decoded"},  // found by fuzz_photo: "P692\n9"
+        // Found by fuzz_photo in CI: a 16-bit PGM cut short, which stb_image read past its buffer.
+        {"pnm16_truncated.pgm", "PNM data is truncated: its header declares 6x3000"},
+        {"truncated.bmp", "BMP data is truncated"},  // the first half of valid.bmp (stb_image filled it with black)
     };
     int seen = 0;
     for (const auto& entry : fs::directory_iterator(corpus("photo"))) {

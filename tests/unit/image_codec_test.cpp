@@ -119,6 +119,78 @@ TEST(ImageCodec, BmpAndBinaryPnmDecodeToTheSamePixelsAsImread) {
     }
 }
 
+// A PNM file: its header text, then the samples as bytes.
+std::vector<unsigned char> pnm(const std::string& header, const std::vector<unsigned char>& samples) {
+    std::vector<unsigned char> bytes(header.begin(), header.end());
+    bytes.insert(bytes.end(), samples.begin(), samples.end());
+    return bytes;
+}
+
+// The blue, green and red of each pixel of a one-row image.
+std::vector<cv::Vec3b> row(const cv::Mat& image) {
+    EXPECT_EQ(image.rows, 1);
+    return std::vector<cv::Vec3b>(image.begin<cv::Vec3b>(), image.end<cv::Vec3b>());
+}
+
+TEST(ImageCodec, PnmSamplesScaleByMaxvalAndWideSamplesAreBigEndian) {
+    using V = cv::Vec3b;
+    // maxval 15: 0..15 spread over 0..255 (round(v * 255 / 15) = 17 v); 20 is above maxval and counts as 15.
+    EXPECT_EQ(row(decoded(pnm("P5 4 1 15\n", {0, 7, 15, 20}))),
+              (std::vector<V>{{0, 0, 0}, {119, 119, 119}, {255, 255, 255}, {255, 255, 255}}));
+    // maxval 255: the samples as they are; P6 is red, green, blue, the result blue, green, red.
+    EXPECT_EQ(row(decoded(pnm("P6\n# a comment\n2 1\n255\n", {1, 2, 3, 250, 251, 252}))),
+              (std::vector<V>{{3, 2, 1}, {252, 251, 250}}));
+    // maxval 1000: two bytes a sample, high byte first. 500 -> round(127.5) = 128, 100 -> round(25.5) = 26.
+    EXPECT_EQ(row(decoded(pnm("P5 4 1 1000\n", {0x00, 0x00, 0x01, 0xF4, 0x03, 0xE8, 0x00, 0x64}))),
+              (std::vector<V>{{0, 0, 0}, {128, 128, 128}, {255, 255, 255}, {26, 26, 26}}));
+    EXPECT_EQ(row(decoded(pnm("P6 1 1 1000\n", {0x03, 0xE8, 0x01, 0xF4, 0x00, 0x00}))),
+              (std::vector<V>{{0, 128, 255}}));
+    // maxval 65535: the high byte, as for 16-bit PNGs and as imread does (0x00FF would round to 1, it gives 0).
+    const auto wide = pnm("P5 4 1 65535\n", {0x00, 0xFF, 0x12, 0x34, 0xFF, 0xFF, 0x80, 0x7F});
+    EXPECT_EQ(row(decoded(wide)), (std::vector<V>{{0, 0, 0}, {0x12, 0x12, 0x12}, {255, 255, 255}, {0x80, 0x80, 0x80}}));
+    EXPECT_EQ(maxDifference(decoded(wide), cv::imdecode(wide, cv::IMREAD_COLOR)), 0.0);
+    // A 16-bit picture written by OpenCV reads back as its high bytes (v * 257 has v in both bytes), and as imread
+    // reads it when the low bytes differ.
+    cv::Mat deep;
+    picture().convertTo(deep, CV_16UC3, 257.0);
+    EXPECT_EQ(maxDifference(decoded(encodedByOpenCv(deep, ".ppm")), picture()), 0.0);
+    const auto noisyPpm = encodedByOpenCv(deep + cv::Scalar(99, 3, 200), ".ppm");
+    EXPECT_EQ(maxDifference(decoded(noisyPpm), cv::imdecode(noisyPpm, cv::IMREAD_COLOR)), 0.0);
+}
+
+TEST(ImageCodec, DamagedPnmHeadersAndShortSamplesGiveTheReason) {
+    const auto reason = [](const std::vector<unsigned char>& bytes) -> std::string {
+        try {
+            decoded(bytes);
+            return "decoded without error";
+        } catch (const ImageDecodeError& e) {
+            return e.what();
+        }
+    };
+    const auto has = [](const std::string& text, const std::string& part) {
+        return text.find(part) != std::string::npos;
+    };
+    // Found by fuzz_photo in CI: 6x3000 with maxval 30000 and four bytes of samples. stb_image read past its
+    // buffer here (AddressSanitizer: SEGV in stbi_load_from_memory).
+    const std::vector<unsigned char> fuzzFound = {'P', '5', '\t', '\t', '6', '\n', '3', '0', '0', '0', ' ', '3', '0',
+                                                  '0', '0', '0', '\n', '2', 0x80, 0x80, 0x80};
+    EXPECT_TRUE(has(reason(fuzzFound), "PNM data is truncated: its header declares 6x3000 but only 4 bytes"))
+        << reason(fuzzFound);
+    // One byte short, in 8 and in 16 bits; one byte more than needed is fine (trailing bytes are ignored).
+    EXPECT_TRUE(has(reason(pnm("P6 2 1 255\n", {1, 2, 3, 4, 5})), "truncated"));
+    EXPECT_TRUE(has(reason(pnm("P5 2 1 256\n", {1, 2, 3})), "truncated"));
+    EXPECT_EQ(decoded(pnm("P5 2 1 255\n", {1, 2, 3})).cols, 2);
+    // Sides far beyond the data (and beyond 32 bits) are refused before anything is allocated.
+    EXPECT_TRUE(has(reason(pnm("P6 99999999999 99999999999 255\n", {1, 2, 3})), "truncated"));
+    EXPECT_TRUE(has(reason(pnm("P5 4 1 0\n", {0, 0, 0, 0})), "maxval 0 is not 1-65535"));
+    EXPECT_TRUE(has(reason(pnm("P5 4 1 70000\n", {0, 0, 0, 0, 0, 0, 0, 0})), "maxval 70000 is not 1-65535"));
+    EXPECT_TRUE(has(reason(pnm("P5 0 4 255\n", {0, 0, 0, 0})), "declares no pixels"));
+    EXPECT_TRUE(has(reason(pnm("P5 4 1", {})), "cut short or damaged"));
+    EXPECT_TRUE(has(reason(pnm("P5 4 1 255", {})), "cut short or damaged"));  // no whitespace after maxval
+    EXPECT_TRUE(has(reason(pnm("P5 4 x 255\n", {0, 0, 0, 0})), "cut short or damaged"));
+    EXPECT_TRUE(has(reason(pnm("P54 1 255\n", {0, 0, 0, 0})), "no space after its P5/P6"));
+}
+
 TEST(ImageCodec, WrittenPngReadsBackExactlyAndImreadAgrees) {
     const cv::Mat bgr = picture();
     const std::string png = encodePng(bgr);
@@ -175,6 +247,11 @@ TEST(ImageCodec, DamagedAndUnknownDataGiveTheReason) {
     expectError({'G', 'I', 'F', '8', '9', 'a', 0, 0}, "is not a JPEG, PNG, BMP or PNM image");
     expectError({'P', '3', '\n', '1', ' ', '1', '\n', '2', '5', '5', '\n', '0', ' ', '0', ' ', '0', '\n'}, "P1-P4");
     expectError({'B', 'M', 0, 0}, "BMP data cannot be decoded");
+    // A BMP cut short: stb_image alone would fill the missing rows with black (96x64 at 24 bits: 54 + 64 * 288).
+    const auto bmp = encodedByOpenCv(picture(), ".bmp");
+    ASSERT_EQ(bmp.size(), 54u + 64u * 288u);
+    expectError(std::vector<unsigned char>(bmp.begin(), bmp.end() - 1), "BMP data is truncated: its header declares 18486 bytes, the file has 18485");
+    expectError(std::vector<unsigned char>(bmp.begin(), bmp.begin() + 60), "BMP data is truncated");
     expectError({'P', '6', '9', '2', '\n', '9'}, "PNM data cannot be decoded");  // found by fuzz_photo
     EXPECT_THROW(encodePng(cv::Mat()), std::runtime_error);
     EXPECT_THROW(encodeJpeg(cv::Mat(4, 4, CV_32FC3), 90), std::runtime_error);
