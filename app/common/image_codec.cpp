@@ -276,10 +276,23 @@ void checkEncodable(const cv::Mat& image, const char* format) {
 // the header is another kind (stb_image refuses RLE itself) or too short to say.
 std::uint64_t bmpDeclaredBytes(const unsigned char* data, std::size_t size) {
     using image_header_detail::littleEndian32;
-    if (size < 34 || littleEndian32(data, 14) < 40) return 0;  // not a BITMAPINFOHEADER or later
-    const std::int64_t width = littleEndian32(data, 18), height = std::abs(std::int64_t{littleEndian32(data, 22)});
-    const unsigned bitsPerPixel = data[28] | unsigned{data[29]} << 8;
-    const std::int32_t compression = littleEndian32(data, 30);
+    const auto le16 = [&](std::size_t at) { return static_cast<unsigned>(data[at] | data[at + 1] << 8); };
+    if (size < 34) return 0;
+    std::int64_t width = 0, height = 0;
+    unsigned bitsPerPixel = 0;
+    std::int32_t compression = 0;
+    if (littleEndian32(data, 14) == 12) {  // OS/2 BITMAPCOREHEADER: 16-bit sides, never compressed
+        width = le16(18);
+        height = le16(20);
+        bitsPerPixel = le16(24);
+    } else if (littleEndian32(data, 14) >= 40) {  // BITMAPINFOHEADER or a later one; a negative height is top-down
+        width = littleEndian32(data, 18);
+        height = std::abs(std::int64_t{littleEndian32(data, 22)});
+        bitsPerPixel = le16(28);
+        compression = littleEndian32(data, 30);
+    } else {
+        return 0;
+    }
     if ((compression != 0 && compression != 3) || width <= 0 || height == 0 || bitsPerPixel == 0 || bitsPerPixel > 32)
         return 0;
     const std::uint64_t rowBytes = (static_cast<std::uint64_t>(width) * bitsPerPixel + 31) / 32 * 4;  // 4-byte rows

@@ -82,8 +82,12 @@ inline ImageHeader readImageHeader(const unsigned char* b, std::size_t n) {
         }
     } else if (n >= 2 && b[0] == 'B' && b[1] == 'M') {
         h.format = ImageFormat::Bmp;
-        if (n >= 26) {
-            // BITMAPINFOHEADER; a negative height means top-down rows.
+        if (n >= 26 && littleEndian32(b, 14) == 12) {
+            // OS/2 BITMAPCOREHEADER: 16-bit sides.
+            h.width = b[18] | b[19] << 8;
+            h.height = b[20] | b[21] << 8;
+        } else if (n >= 26) {
+            // BITMAPINFOHEADER and later; a negative height means top-down rows.
             h.width = littleEndian32(b, 18);
             const std::int64_t height = littleEndian32(b, 22);
             h.height = height < 0 ? -height : height;

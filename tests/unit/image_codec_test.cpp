@@ -2,6 +2,7 @@
 // imread made of it before (the tests link imgcodecs to compare; the product does not), EXIF orientation included;
 // written files read back exactly (PNG) or closely (JPEG); damaged files give the decoder's reason.
 #include "common/image_codec.h"
+#include "common/image_header.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -189,6 +190,30 @@ TEST(ImageCodec, DamagedPnmHeadersAndShortSamplesGiveTheReason) {
     EXPECT_TRUE(has(reason(pnm("P5 4 1 255", {})), "cut short or damaged"));  // no whitespace after maxval
     EXPECT_TRUE(has(reason(pnm("P5 4 x 255\n", {0, 0, 0, 0})), "cut short or damaged"));
     EXPECT_TRUE(has(reason(pnm("P54 1 255\n", {0, 0, 0, 0})), "no space after its P5/P6"));
+}
+
+TEST(ImageCodec, Os2BitmapDeclaresItsSizeAndDecodes) {
+    // A 2x2 24-bit BMP with the 12-byte OS/2 header (16-bit sides): rows bottom-up, blue-green-red, 4-byte rows.
+    std::vector<unsigned char> bmp = {'B', 'M', 42, 0, 0, 0, 0, 0, 0, 0, 26, 0, 0, 0,  // file header, pixels at 26
+                                      12, 0, 0, 0, 2, 0, 2, 0, 1, 0, 24, 0,             // core header: 2x2, 24 bits
+                                      10, 20, 30, 40, 50, 60, 0, 0,                     // bottom row
+                                      70, 80, 90, 100, 110, 120, 0, 0};                 // top row
+    const ImageHeader header = readImageHeader(bmp.data(), bmp.size());
+    EXPECT_EQ(header.format, ImageFormat::Bmp);
+    EXPECT_EQ(header.width, 2);  // not the two 16-bit fields read as one 32-bit number
+    EXPECT_EQ(header.height, 2);
+    const cv::Mat image = decoded(bmp);
+    ASSERT_EQ(image.size(), cv::Size(2, 2));
+    EXPECT_EQ(image.at<cv::Vec3b>(0, 0), cv::Vec3b(70, 80, 90));
+    EXPECT_EQ(image.at<cv::Vec3b>(1, 1), cv::Vec3b(40, 50, 60));
+    bmp.pop_back();
+    try {
+        decoded(bmp);
+        ADD_FAILURE() << "a BMP one byte short decoded";
+    } catch (const ImageDecodeError& e) {
+        EXPECT_NE(std::string(e.what()).find("BMP data is truncated: its header declares 42 bytes, the file has 41"),
+                  std::string::npos) << e.what();
+    }
 }
 
 TEST(ImageCodec, WrittenPngReadsBackExactlyAndImreadAgrees) {
