@@ -277,7 +277,7 @@ void checkEncodable(const cv::Mat& image, const char* format) {
 std::uint64_t bmpDeclaredBytes(const unsigned char* data, std::size_t size) {
     using image_header_detail::littleEndian32;
     const auto le16 = [&](std::size_t at) { return static_cast<unsigned>(data[at] | data[at + 1] << 8); };
-    if (size < 34) return 0;
+    if (size < 26) return 0;
     std::int64_t width = 0, height = 0;
     unsigned bitsPerPixel = 0;
     std::int32_t compression = 0;
@@ -285,7 +285,7 @@ std::uint64_t bmpDeclaredBytes(const unsigned char* data, std::size_t size) {
         width = le16(18);
         height = le16(20);
         bitsPerPixel = le16(24);
-    } else if (littleEndian32(data, 14) >= 40) {  // BITMAPINFOHEADER or a later one; a negative height is top-down
+    } else if (littleEndian32(data, 14) >= 40 && size >= 34) {  // BITMAPINFOHEADER or a later one; a negative height is top-down
         width = littleEndian32(data, 18);
         height = std::abs(std::int64_t{littleEndian32(data, 22)});
         bitsPerPixel = le16(28);

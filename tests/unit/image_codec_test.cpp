@@ -206,7 +206,15 @@ TEST(ImageCodec, Os2BitmapDeclaresItsSizeAndDecodes) {
     ASSERT_EQ(image.size(), cv::Size(2, 2));
     EXPECT_EQ(image.at<cv::Vec3b>(0, 0), cv::Vec3b(70, 80, 90));
     EXPECT_EQ(image.at<cv::Vec3b>(1, 1), cv::Vec3b(40, 50, 60));
+    const std::vector<unsigned char> headerOnly(bmp.begin(), bmp.begin() + 26);
     bmp.pop_back();
+    try {
+        decoded(headerOnly);
+        ADD_FAILURE() << "a BMP with no pixels decoded";
+    } catch (const ImageDecodeError& e) {
+        EXPECT_NE(std::string(e.what()).find("BMP data is truncated: its header declares 42 bytes, the file has 26"),
+                  std::string::npos) << e.what();
+    }
     try {
         decoded(bmp);
         ADD_FAILURE() << "a BMP one byte short decoded";
