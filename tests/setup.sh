@@ -14,7 +14,7 @@ packages=(
   libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libx11-dev
   libcli11-dev libspdlog-dev libtomlplusplus-dev libsystemd-dev libgpiod-dev libcamera-dev
   libfreetype-dev fonts-dejavu-core fonts-vlgothic
-  # image files (app/common/image_codec): libjpeg-turbo, libpng, libexif (orientation), stb_image (BMP, PNM)
+  # image files (app/common/image_codec): libjpeg-turbo, libpng, libexif (orientation), stb_image (BMP)
   libjpeg-dev libpng-dev libexif-dev libstb-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   systemd device-tree-compiler

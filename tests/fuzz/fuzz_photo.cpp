@@ -1,5 +1,5 @@
 // libFuzzer target: the photo loading path (common/image_io readPhoto: header checks, then the decoders of
-// common/image_codec: libjpeg-turbo, libpng, stb_image).
+// common/image_codec: libjpeg-turbo, libpng, stb_image for BMP, its own PNM reader).
 // Every input must end in a decoded image or a BoothError; anything else (another exception, a sanitizer report,
 // an allocation beyond the limit) is a bug.
 #include "fuzz_files.h"
