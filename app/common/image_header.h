@@ -1,6 +1,7 @@
 // The size an image file declares in its header (JPEG frame header, PNG IHDR, BMP info header, PNM header),
 // read before decoding so that a small file declaring a huge image is refused instead of making the decoder
-// allocate gigabytes. Header-only: the camera driver library (sim camera) uses it without linking booth_core.
+// allocate gigabytes. readPhoto (common/image_io), which every photo the booth reads goes through, the sim
+// camera's included, checks it; the PNM reader in image_codec.cpp shares its number parser.
 #pragma once
 
 #include <cstddef>
