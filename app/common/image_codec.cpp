@@ -275,31 +275,14 @@ void checkEncodable(const cv::Mat& image, const char* format) {
 // The bytes an uncompressed (or bit-field) BMP needs by its header, the kinds cameras and editors write; 0 when
 // the header is another kind (stb_image refuses RLE itself) or too short to say.
 std::uint64_t bmpDeclaredBytes(const unsigned char* data, std::size_t size) {
-    using image_header_detail::littleEndian32;
-    const auto le16 = [&](std::size_t at) { return static_cast<unsigned>(data[at] | data[at + 1] << 8); };
-    if (size < 26) return 0;
-    std::int64_t width = 0, height = 0;
-    unsigned bitsPerPixel = 0;
-    std::int32_t compression = 0;
-    if (littleEndian32(data, 14) == 12) {  // OS/2 BITMAPCOREHEADER: 16-bit sides, never compressed
-        width = le16(18);
-        height = le16(20);
-        bitsPerPixel = le16(24);
-    } else if (littleEndian32(data, 14) >= 40 && size >= 34) {  // BITMAPINFOHEADER or a later one; a negative height is top-down
-        width = littleEndian32(data, 18);
-        height = std::abs(std::int64_t{littleEndian32(data, 22)});
-        bitsPerPixel = le16(28);
-        compression = littleEndian32(data, 30);
-    } else {
+    const BmpLayout l = readBmpLayout(data, size);
+    if (!l.layoutKnown || (l.compression != 0 && l.compression != 3) || l.width <= 0 || l.height == 0 ||
+        l.bitsPerPixel == 0 || l.bitsPerPixel > 32)
         return 0;
-    }
-    if ((compression != 0 && compression != 3) || width <= 0 || height == 0 || bitsPerPixel == 0 || bitsPerPixel > 32)
-        return 0;
-    const std::uint64_t rowBytes = (static_cast<std::uint64_t>(width) * bitsPerPixel + 31) / 32 * 4;  // 4-byte rows
-    const auto pixelsAt = static_cast<std::uint32_t>(littleEndian32(data, 10));
-    const auto rows = static_cast<std::uint64_t>(height);
-    if (rows > (UINT64_MAX - pixelsAt) / rowBytes) return UINT64_MAX;  // sides up to 2^31: the product may overflow
-    return pixelsAt + rowBytes * rows;
+    const std::uint64_t rowBytes = (static_cast<std::uint64_t>(l.width) * l.bitsPerPixel + 31) / 32 * 4;  // 4-byte rows
+    const auto rows = static_cast<std::uint64_t>(l.height);
+    if (rows > (UINT64_MAX - l.pixelsAt) / rowBytes) return UINT64_MAX;  // sides up to 2^31: the product may overflow
+    return l.pixelsAt + rowBytes * rows;
 }
 
 cv::Mat decodeBmp(const unsigned char* data, std::size_t size) {

@@ -1,11 +1,12 @@
 // The size an image file declares in its header (JPEG frame header, PNG IHDR, BMP info header, PNM header),
 // read before decoding so that a small file declaring a huge image is refused instead of making the decoder
 // allocate gigabytes. readPhoto (common/image_io), which every photo the booth reads goes through, the sim
-// camera's included, checks it; the PNM reader in image_codec.cpp shares its number parser.
+// camera's included, checks it; the BMP and PNM readers in image_codec.cpp share its header parsing.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 
 namespace avatarbooth {
 
@@ -54,6 +55,41 @@ inline std::int64_t pnmNumber(const unsigned char* b, std::size_t n, std::size_t
 
 }  // namespace image_header_detail
 
+// What a BMP's headers say of its size and pixel layout: the sides (from 26 bytes on), and the rest from an OS/2
+// core header (12 bytes: 16-bit sides, never compressed) or a BITMAPINFOHEADER or later one (40 bytes or more)
+// when the data holds them (`layoutKnown`).
+struct BmpLayout {
+    std::int64_t width = 0, height = 0;  // height without its sign (negative: rows top-down)
+    bool layoutKnown = false;
+    unsigned bitsPerPixel = 0;
+    std::int32_t compression = 0;  // 0: none, 3: bit fields, 1 and 2: RLE
+    std::uint32_t pixelsAt = 0;    // the pixel array's offset in the file
+};
+
+inline BmpLayout readBmpLayout(const unsigned char* b, std::size_t n) {
+    using namespace image_header_detail;
+    BmpLayout l;
+    if (n < 26) return l;
+    const auto littleEndian16 = [&](std::size_t at) { return static_cast<unsigned>(b[at] | b[at + 1] << 8); };
+    const std::int32_t headerSize = littleEndian32(b, 14);
+    if (headerSize == 12) {
+        l.width = littleEndian16(18);
+        l.height = littleEndian16(20);
+        l.bitsPerPixel = littleEndian16(24);
+        l.layoutKnown = true;
+    } else {
+        l.width = littleEndian32(b, 18);
+        l.height = std::abs(std::int64_t{littleEndian32(b, 22)});
+        if (headerSize >= 40 && n >= 34) {
+            l.bitsPerPixel = littleEndian16(28);
+            l.compression = littleEndian32(b, 30);
+            l.layoutKnown = true;
+        }
+    }
+    l.pixelsAt = static_cast<std::uint32_t>(littleEndian32(b, 10));
+    return l;
+}
+
 inline ImageHeader readImageHeader(const unsigned char* b, std::size_t n) {
     using namespace image_header_detail;
     ImageHeader h;
@@ -83,16 +119,9 @@ inline ImageHeader readImageHeader(const unsigned char* b, std::size_t n) {
         }
     } else if (n >= 2 && b[0] == 'B' && b[1] == 'M') {
         h.format = ImageFormat::Bmp;
-        if (n >= 26 && littleEndian32(b, 14) == 12) {
-            // OS/2 BITMAPCOREHEADER: 16-bit sides.
-            h.width = b[18] | b[19] << 8;
-            h.height = b[20] | b[21] << 8;
-        } else if (n >= 26) {
-            // BITMAPINFOHEADER and later; a negative height means top-down rows.
-            h.width = littleEndian32(b, 18);
-            const std::int64_t height = littleEndian32(b, 22);
-            h.height = height < 0 ? -height : height;
-        }
+        const BmpLayout layout = readBmpLayout(b, n);
+        h.width = layout.width;
+        h.height = layout.height;
     } else if (n >= 2 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6') {
         h.format = ImageFormat::Pnm;
         std::size_t at = 2;
