@@ -56,8 +56,8 @@ public:
     SimLamps(std::vector<std::string> names, const Clock& clock);
     // Records a change only when the state changes (setting a lamp to what it is records nothing).
     void set(const std::string& name, bool on) override;
-    // The changes (changes()) are a record for tests, so only the most recent are kept: the
-    // simulated booth (`avatarbooth run`) may run for days, and a visitor's session makes a few dozen changes.
+    // The changes (changes()) are a record for tests, so only the most recent are kept: the simulated booth
+    // (`avatarbooth run`) may run for days, and a visitor's session makes a few dozen changes.
     // At least kKeptChanges / 2 of them, at most kKeptChanges, oldest first.
     static constexpr std::size_t kKeptChanges = 4096;
     bool isOn(const std::string& name) const override;
