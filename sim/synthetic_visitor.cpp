@@ -4,9 +4,9 @@
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/image_io.h"
-#include "export/glb.h"
-#include "face/landmarks68.h"
-#include "head/surface_texels.h"
+#include "fit/export/glb.h"
+#include "fit/face/landmarks68.h"
+#include "fit/head/surface_texels.h"
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>

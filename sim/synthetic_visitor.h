@@ -8,8 +8,8 @@
 // dlib's face detector and landmark predictor find it.
 #pragma once
 
-#include "head/base_head.h"
-#include "head/mesh.h"
+#include "fit/head/base_head.h"
+#include "fit/head/mesh.h"
 #include "render/mesh_renderer.h"
 
 #include <opencv2/core.hpp>

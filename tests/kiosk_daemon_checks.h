@@ -3,7 +3,7 @@
 #pragma once
 
 #include "booth/flow_types.h"
-#include "screens/screens.h"
+#include "booth/screens/screens.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>

@@ -2,7 +2,7 @@
 // as regions of their own, one skin (maybe one shade) on the cheeks, and the parts matched between the views.
 #pragma once
 
-#include "toon/toon_billboard.h"
+#include "reveal/toon/toon_billboard.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>

@@ -4,7 +4,7 @@
 
 #include "batch/batch_runner.h"
 #include "common/error.h"
-#include "pipeline/fit_pipeline.h"
+#include "fit/fit_pipeline.h"
 
 #include <memory>
 

@@ -2,9 +2,9 @@
 #include "booth/guidance.h"
 
 #include "common/error.h"
-#include "face/landmarks68.h"
-#include "face/profile.h"
-#include "face/silhouette.h"
+#include "fit/face/landmarks68.h"
+#include "fit/face/profile.h"
+#include "fit/face/silhouette.h"
 
 #include <opencv2/imgproc.hpp>
 

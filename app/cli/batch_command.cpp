@@ -9,7 +9,7 @@
 #include "cli/exit_codes.h"
 #include "common/error.h"
 #include "config/booth_config.h"
-#include "pipeline/fit_pipeline.h"
+#include "fit/fit_pipeline.h"
 
 #include <signal.h>
 #include <unistd.h>

@@ -4,7 +4,7 @@
 
 #include "common/image_io.h"
 #include "common/recent_timings.h"
-#include "pipeline/fit_pipeline.h"
+#include "fit/fit_pipeline.h"
 
 #include <chrono>
 #include <fstream>

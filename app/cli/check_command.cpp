@@ -12,8 +12,8 @@
 #include "drivers/camera/camera_factory.h"
 #include "drivers/display/kms_display.h"
 #include "drivers/gpio/gpiod_lines.h"
-#include "face/landmarks68.h"
-#include "screens/strings.h"
+#include "fit/face/landmarks68.h"
+#include "booth/screens/strings.h"
 
 #include <nlohmann/json.hpp>
 

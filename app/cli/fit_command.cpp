@@ -3,7 +3,7 @@
 
 #include "common/error.h"
 #include "config/booth_config.h"
-#include "pipeline/fit_pipeline.h"
+#include "fit/fit_pipeline.h"
 
 #include <iostream>
 

@@ -3,8 +3,8 @@
 #include "cli/commands.h"
 
 #include "common/atomic_output.h"
-#include "export/glb.h"
-#include "head/base_head.h"
+#include "fit/export/glb.h"
+#include "fit/head/base_head.h"
 #include "sim/synthetic_visitor.h"
 
 #include <iostream>

@@ -4,9 +4,9 @@
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/image_io.h"
-#include "face/landmarks68.h"
-#include "toon/toon_billboard.h"
-#include "toon/toon_correspondence.h"
+#include "fit/face/landmarks68.h"
+#include "reveal/toon/toon_billboard.h"
+#include "reveal/toon/toon_correspondence.h"
 
 #include <algorithm>
 #include <chrono>

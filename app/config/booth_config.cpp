@@ -4,7 +4,7 @@
 
 #include "common/error.h"
 #include "config/config_schema.h"
-#include "stage/tile_stage.h"
+#include "reveal/stage/tile_stage.h"
 
 #include <toml++/toml.h>
 

@@ -7,17 +7,17 @@
 // --print-default` (kept as app/assets/booth.toml, installed as /etc/avatarbooth/booth.toml).
 #pragma once
 
-#include "animation/avatar_motion.h"
+#include "reveal/animation/avatar_motion.h"
 #include "booth/guidance.h"
 #include "booth/session_store.h"
 #include "booth/visitor_flow.h"
 #include "drivers/camera/camera_settings.h"
 #include "drivers/display/display_settings.h"
 #include "drivers/gpio/gpio_settings.h"
-#include "head/base_head.h"
-#include "kiosk/style_settings.h"
-#include "pipeline/fit_pipeline.h"
-#include "screens/screens.h"
+#include "fit/head/base_head.h"
+#include "reveal/styles/style_settings.h"
+#include "fit/fit_pipeline.h"
+#include "booth/screens/screens.h"
 
 #include <filesystem>
 #include <memory>

@@ -1,8 +1,8 @@
 // Every table and key of booth.toml, and the default file and Markdown reference rendered from them.
 #include "config/config_schema.h"
 
-#include "character/proportions.h"
-#include "head/rbf.h"
+#include "reveal/character/proportions.h"
+#include "fit/head/rbf.h"
 
 #include <charconv>
 #include <chrono>

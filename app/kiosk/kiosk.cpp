@@ -1,7 +1,7 @@
 // The kiosk's main loop and its worker threads (model loading + fitting, preview analysis).
 #include "kiosk/kiosk.h"
 
-#include "kiosk/avatar_stage.h"
+#include "reveal/styles/avatar_stage.h"
 #include "kiosk/session_writer.h"
 
 #include "booth/guidance.h"
@@ -18,10 +18,10 @@
 #include "drivers/gpio/button_board.h"
 #include "drivers/gpio/clock.h"
 #include "drivers/gpio/lamps.h"
-#include "face/landmarks68.h"
-#include "kiosk/reveal_styles.h"
-#include "pipeline/fit_pipeline.h"
-#include "screens/screens.h"
+#include "fit/face/landmarks68.h"
+#include "reveal/styles/reveal_styles.h"
+#include "fit/fit_pipeline.h"
+#include "booth/screens/screens.h"
 
 #include <spdlog/spdlog.h>
 #include <systemd/sd-daemon.h>

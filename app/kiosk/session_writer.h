@@ -3,7 +3,7 @@
 #pragma once
 
 #include "common/error.h"
-#include "pipeline/fit_pipeline.h"
+#include "fit/fit_pipeline.h"
 
 #include <condition_variable>
 #include <cstdint>

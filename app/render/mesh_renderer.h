@@ -1,7 +1,7 @@
 // Offscreen rendering of one textured head mesh into colour, coverage mask and depth images (OpenGL ES 3).
 #pragma once
 
-#include "head/mesh.h"
+#include "fit/head/mesh.h"
 
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>

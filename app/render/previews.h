@@ -1,7 +1,7 @@
 // Preview images of a fitted head (front, side, three-quarter) for the reveal screen and the session folder.
 #pragma once
 
-#include "head/mesh.h"
+#include "fit/head/mesh.h"
 #include "render/mesh_renderer.h"
 
 #include <opencv2/core.hpp>

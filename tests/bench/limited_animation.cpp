@@ -2,10 +2,10 @@
 // 88/4/29, Baseball swing 120/6/40; the thesis reports 27-69 ms) with our rig's 5 points and a 20-joint body, the
 // avatar's reveal played limited, and the character maker's costs (proportions, mapping, character head).
 // Prints figures (medians of 5 repetitions); never fails on speed.
-#include "animation/avatar_motion.h"
-#include "animation/limited_animation.h"
-#include "character/character_head.h"
-#include "character/proportions.h"
+#include "reveal/animation/avatar_motion.h"
+#include "reveal/animation/limited_animation.h"
+#include "reveal/character/character_head.h"
+#include "reveal/character/proportions.h"
 
 #include <benchmark/benchmark.h>
 

@@ -5,8 +5,8 @@
 // minus this floor is the memory the booth's own work takes. Prints figures; never fails on size.
 // Usage: bench_memory_floor [landmark model]   (default: Debian's libdlib-data model)
 #include "drivers/display/headless_egl.h"
-#include "face/landmarks68.h"
-#include "head/base_head.h"
+#include "fit/face/landmarks68.h"
+#include "fit/head/base_head.h"
 #include "kiosk/kiosk.h"
 #include "render/mesh_renderer.h"
 #include "sim/process_figures.h"

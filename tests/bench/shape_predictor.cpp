@@ -2,8 +2,8 @@
 // against face/quantized_shape_predictor (16-bit leaves, what the booth runs), on a FRMDB front photo, plus the
 // memory each holds. Prints figures; never fails on speed.
 #include "common/image_io.h"
-#include "face/landmarks68.h"
-#include "face/quantized_shape_predictor.h"
+#include "fit/face/landmarks68.h"
+#include "fit/face/quantized_shape_predictor.h"
 #include "test_paths.h"
 
 #include <benchmark/benchmark.h>

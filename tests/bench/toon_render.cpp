@@ -3,7 +3,7 @@
 // fails on speed. Needs ../shared/data (or $AVATARBOOTH_SHARED_DATA).
 #include "common/image_io.h"
 #include "test_paths.h"
-#include "toon/toon_billboard.h"
+#include "reveal/toon/toon_billboard.h"
 
 #include <benchmark/benchmark.h>
 

@@ -2,7 +2,7 @@
 // seen as a profile facing the right way, no front is taken for a profile, and no 45-degree view says "hold still".
 #include "booth/guidance.h"
 #include "common/image_io.h"
-#include "face/landmarks68.h"
+#include "fit/face/landmarks68.h"
 #include "test_paths.h"
 
 #include <opencv2/imgproc.hpp>

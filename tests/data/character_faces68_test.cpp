@@ -2,10 +2,10 @@
 // booth computes (segmentPerson, no background plate): temples on the silhouette's edge at eye height, ears on its
 // edge and outside the face, spanning the eye line; a rotated and scaled copy of each photo's analysis gives the
 // same ratios. Overlays land in the work folder for a person to look at.
-#include "character/proportions.h"
+#include "reveal/character/proportions.h"
 #include "common/image_io.h"
 #include "ibug_pts.h"
-#include "face/silhouette.h"
+#include "fit/face/silhouette.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>

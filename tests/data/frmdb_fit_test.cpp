@@ -2,8 +2,8 @@
 // directions; the overlays and previews are written for a person to look at.
 #include "test_paths.h"
 
-#include "export/glb.h"
-#include "pipeline/fit_pipeline.h"
+#include "fit/export/glb.h"
+#include "fit/fit_pipeline.h"
 
 #include <gtest/gtest.h>
 

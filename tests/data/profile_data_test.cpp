@@ -2,7 +2,7 @@
 // overlays for a person to look at), their front photos refused, and the scan's side renders against landmarks
 // taken from the scan's mesh and projected with the renders' exact cameras.
 #include "common/error.h"
-#include "face/profile.h"
+#include "fit/face/profile.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>

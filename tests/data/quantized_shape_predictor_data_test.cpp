@@ -2,8 +2,8 @@
 // same face boxes, landmarks within a pixel; and a damaged model file gives a clear error.
 #include "common/error.h"
 #include "common/image_io.h"
-#include "face/landmarks68.h"
-#include "face/quantized_shape_predictor.h"
+#include "fit/face/landmarks68.h"
+#include "fit/face/quantized_shape_predictor.h"
 #include "ibug_pts.h"
 #include "test_paths.h"
 

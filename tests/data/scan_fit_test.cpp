@@ -2,9 +2,9 @@
 // compare the fitted head's surface with the scan's head region, after a similarity alignment (ICP with scale).
 #include "test_paths.h"
 
-#include "export/glb.h"
-#include "head/shape_compare.h"
-#include "pipeline/fit_pipeline.h"
+#include "fit/export/glb.h"
+#include "fit/head/shape_compare.h"
+#include "fit/fit_pipeline.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/flann.hpp>

@@ -2,7 +2,7 @@
 // (exact mask, a textured backdrop), and the frmdb photos (dark hair on a dark cloth; overlays for a person to look
 // at in the scratch folder).
 #include "common/error.h"
-#include "face/silhouette.h"
+#include "fit/face/silhouette.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>

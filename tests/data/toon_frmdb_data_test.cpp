@@ -2,9 +2,9 @@
 // counts and sizes of one pair within ranges measured on all 16 FRMDB pairs with `avatarbooth toon` (with margins), the largest
 // region the face's skin.
 #include "common/image_io.h"
-#include "face/landmarks68.h"
+#include "fit/face/landmarks68.h"
 #include "test_paths.h"
-#include "toon/toon_billboard.h"
+#include "reveal/toon/toon_billboard.h"
 #include "toon_face_parts.h"
 
 #include <gtest/gtest.h>

@@ -3,7 +3,7 @@
 // and the toon's turntable strip.
 #include "run_binary.h"
 
-#include "screens/screens.h"
+#include "booth/screens/screens.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>

@@ -2,7 +2,7 @@
 // are seen as profiles and its front is not, the empty booth has nobody, and the preview analyses' rates are
 // printed (the real photos' test is tests/data/booth_guidance_data_test.cpp).
 #include "booth/guidance.h"
-#include "face/landmarks68.h"
+#include "fit/face/landmarks68.h"
 #include "sim/synthetic_visitor.h"
 
 #include <opencv2/imgproc.hpp>

@@ -5,7 +5,7 @@
 
 #include "drivers/camera/camera_factory.h"
 #include "drivers/camera/sim_camera.h"
-#include "head/base_head.h"
+#include "fit/head/base_head.h"
 #include "render/mesh_renderer.h"
 #include "sim/synthetic_visitor.h"
 

@@ -2,10 +2,10 @@
 // back, what it was made to; character.json and character.glb in the session folder of a fitted synthetic
 // visitor, written before fit.json, with the ear hole from the side photo and ratios close to what the visitor's
 // true landmarks give.
-#include "character/character_head.h"
-#include "character/character_outputs.h"
-#include "export/glb.h"
-#include "pipeline/fit_pipeline.h"
+#include "reveal/character/character_head.h"
+#include "reveal/character/character_outputs.h"
+#include "fit/export/glb.h"
+#include "fit/fit_pipeline.h"
 #include "sim/synthetic_visitor.h"
 #include "test_paths.h"
 

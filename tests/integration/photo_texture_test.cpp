@@ -1,9 +1,9 @@
 // The texture step on the synthetic visitor, whose painted texture is known: photographed without shading, the
 // head fitted from its true landmarks and textured from the two photos must give back the paint where they see it.
-#include "face/silhouette.h"
-#include "head/head_fit.h"
-#include "head/photo_texture.h"
-#include "head/surface_texels.h"
+#include "fit/face/silhouette.h"
+#include "fit/head/head_fit.h"
+#include "fit/head/photo_texture.h"
+#include "fit/head/surface_texels.h"
 #include "sim/synthetic_visitor.h"
 
 #include <gtest/gtest.h>

@@ -1,15 +1,15 @@
 // Integration tests of the reveal's styles: the stage view (R(theta) sweep, one render per angle), the character and
 // toon renderers through RevealStyles on the synthetic visitor, the toon strip kept, and the screens' layout of them.
-#include "character/character_head.h"
+#include "reveal/character/character_head.h"
 #include "common/error.h"
-#include "face/silhouette.h"
-#include "head/base_head.h"
-#include "kiosk/reveal_styles.h"
+#include "fit/face/silhouette.h"
+#include "fit/head/base_head.h"
+#include "reveal/styles/reveal_styles.h"
 #include "render/mesh_renderer.h"
 #include "sim/synthetic_visitor.h"
-#include "stage/stage_view.h"
+#include "reveal/stage/stage_view.h"
 #include "test_paths.h"
-#include "toon/toon_billboard.h"
+#include "reveal/toon/toon_billboard.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>

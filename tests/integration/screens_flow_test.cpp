@@ -2,7 +2,7 @@
 // retake and a lost camera) drives VisitorFlow, and every model it produces is drawn by ScreenRenderer. Writes the
 // sequence as PNGs (tests/work/screens_flow/) and checks that each screen of a session is reached and drawn.
 #include "booth/visitor_flow.h"
-#include "screens/screens.h"
+#include "booth/screens/screens.h"
 #include "test_paths.h"
 
 #include <opencv2/imgcodecs.hpp>

@@ -1,11 +1,11 @@
 // Every screen drawn in both languages, landscape and portrait, checked on its pixels (text where it belongs, the
 // preview mirrored, the code's glyphs, the avatar, the labels by their buttons), written as PNGs into
 // build/.../tests/work/screens/ for a person to look at, and timed at 1280x720 (printed, not asserted).
-#include "screens/screens.h"
+#include "booth/screens/screens.h"
 
 #include "common/error.h"
 
-#include "head/base_head.h"
+#include "fit/head/base_head.h"
 #include "render/mesh_renderer.h"
 #include "sim/synthetic_visitor.h"
 #include "test_paths.h"

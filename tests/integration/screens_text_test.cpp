@@ -1,7 +1,7 @@
 // The strings file (every key in both languages, errors that name file, line and key), the fonts (Debian's files,
 // clear errors) and the FreeType text renderer (pixels drawn, fallback to the Japanese font, glyph cache, wrapping).
-#include "screens/strings.h"
-#include "screens/text_renderer.h"
+#include "booth/screens/strings.h"
+#include "booth/screens/text_renderer.h"
 
 #include "common/error.h"
 #include "test_paths.h"

@@ -1,6 +1,6 @@
 // Integration test of the tile stage: the shipped sample map builds, and a box renders with the expected coverage.
 #include "render/mesh_renderer.h"
-#include "stage/tile_stage.h"
+#include "reveal/stage/tile_stage.h"
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,10 @@
 // Fitting the synthetic visitor, whose true shape is known: with ground-truth landmarks the fitted head must be
 // within 1 % of head height (RMS over the head's vertices, after a similarity alignment).
-#include "face/landmarks68.h"
-#include "face/silhouette.h"
-#include "pipeline/fit_pipeline.h"
-#include "head/head_fit.h"
-#include "head/shape_compare.h"
+#include "fit/face/landmarks68.h"
+#include "fit/face/silhouette.h"
+#include "fit/fit_pipeline.h"
+#include "fit/head/head_fit.h"
+#include "fit/head/shape_compare.h"
 #include "sim/synthetic_visitor.h"
 
 #include <gtest/gtest.h>

@@ -1,10 +1,10 @@
 // Integration test of the toon character from photos: the synthetic visitor's pair to a turntable strip of PNGs.
-#include "face/silhouette.h"
-#include "head/base_head.h"
+#include "fit/face/silhouette.h"
+#include "fit/head/base_head.h"
 #include "render/mesh_renderer.h"
 #include "sim/synthetic_visitor.h"
 #include "test_paths.h"
-#include "toon/toon_billboard.h"
+#include "reveal/toon/toon_billboard.h"
 #include "toon_face_parts.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // Kitamura's limited-animation filter (Algorithms 2 and 3) on small hand-made motions whose every step was
 // worked out by hand: ties, the copy limit, length, where frames go, iterating against deleting all at once.
-#include "animation/limited_animation.h"
+#include "reveal/animation/limited_animation.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The avatar's keyframed motion: easing between keys, the rig's kinematics, the reveal and attract clips played
 // full and limited, the settings' checks.
-#include "animation/avatar_motion.h"
+#include "reveal/animation/avatar_motion.h"
 #include "common/error.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // The built-in base head: closed, UV-covered, with distinct feature vertices where an adult head has them.
-#include "head/base_head.h"
-#include "head/head_views.h"
+#include "fit/head/base_head.h"
+#include "fit/head/head_views.h"
 
 #include <gtest/gtest.h>
 

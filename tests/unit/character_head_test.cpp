@@ -1,6 +1,6 @@
 // The character head: its parts follow the proportions it is given (measured back the way a photo is), a bigger
 // eye ratio gives measurably bigger eyes, exaggeration and clamping, the toon texture, colours from a photo.
-#include "character/character_head.h"
+#include "reveal/character/character_head.h"
 #include "common/landmark_names.h"
 
 #include <gtest/gtest.h>

@@ -1,8 +1,8 @@
 // The mapping from 68 landmarks + silhouette (+ ear hole) to Narita's 21 points: exact edges on a hand-made mask,
 // the built-in base head seen as a photo (its ears are on its silhouette), the canon when ears are hidden, and a
 // rotated and scaled copy of the same view giving the same ratios.
-#include "character/character_head.h"
-#include "character/narita_points.h"
+#include "reveal/character/character_head.h"
+#include "reveal/character/narita_points.h"
 #include "common/error.h"
 
 #include <gtest/gtest.h>

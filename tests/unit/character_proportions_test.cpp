@@ -1,6 +1,6 @@
 // Narita's ratios on hand-made point sets whose every length was worked out by hand, and on rotated, translated
 // and scaled copies of them (the ratios and tilts must not change); the sliders and character.json.
-#include "character/proportions.h"
+#include "reveal/character/proportions.h"
 #include "common/error.h"
 
 #include <gtest/gtest.h>

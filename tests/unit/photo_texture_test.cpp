@@ -1,8 +1,8 @@
 // The texture step on synthetic geometry with analytic photos: occlusion (a texel hidden from a photo does not take
 // its colour), the multi-band seam (no step where the photos agree, a gradual one where they do not), the fill.
-#include "head/photo_texture.h"
-#include "head/surface_texels.h"
-#include "head/view_depth.h"
+#include "fit/head/photo_texture.h"
+#include "fit/head/surface_texels.h"
+#include "fit/head/view_depth.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>

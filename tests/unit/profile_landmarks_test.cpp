@@ -1,6 +1,6 @@
 // Profile landmarks on a synthetic head-and-shoulders outline whose landmarks sit at known polygon vertices.
 #include "common/error.h"
-#include "face/profile.h"
+#include "fit/face/profile.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // RBF warps: exact interpolation, known values per kernel, solved rather than approximated.
-#include "head/rbf.h"
+#include "fit/head/rbf.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // UTF-8 decoding for on-screen text: every form of valid input, and invalid bytes shown as U+FFFD.
-#include "screens/text_renderer.h"
+#include "booth/screens/text_renderer.h"
 
 #include "common/error.h"
 

@@ -1,6 +1,6 @@
 // Unit tests of the tile stage: the map format, every generation rule on a small map, the mesh and R(theta).
 #include "common/error.h"
-#include "stage/tile_stage.h"
+#include "reveal/stage/tile_stage.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Unit tests of the toon's editable correspondence file: round trip, edits changing the 3-D result, errors.
 #include "common/error.h"
-#include "toon/toon_correspondence.h"
+#include "reveal/toon/toon_correspondence.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>

@@ -1,6 +1,6 @@
 // Unit tests of the two-view toon character: regions, matching, Algorithm 1, rendering on synthetic drawings.
-#include "toon/toon_billboard.h"
-#include "toon/toon_regions.h"
+#include "reveal/toon/toon_billboard.h"
+#include "reveal/toon/toon_regions.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>

@@ -1,0 +1,58 @@
+// The generic base head that every visitor's head is fitted from (METHODS §1): a closed mesh with UVs over the
+// whole head, and the feature vertices the fit moves onto measured positions.
+#pragma once
+
+#include "fit/head/mesh.h"
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace avatarbooth {
+
+// A vertex on the head's outline seen from the front (or the side), found by a ray from the view's centre
+// (eye midpoint for the front, ear hole for the side) at an angle in degrees, counter-clockwise from the
+// image's +x (subject's left in the front view, the face direction +z in the side view), y up.
+struct ContourVertex {
+    double angleDeg = 0.0;
+    std::uint32_t vertex = 0;
+};
+
+struct BaseHead {
+    Mesh mesh;
+    // Feature vertices for the front photo's landmarks, keyed by landmark name ("ibug_00" .. "ibug_67").
+    std::map<std::string, std::uint32_t> frontFeatures;
+    // Feature vertices for the side photo's profile landmarks (nose_tip, chin, ...; see face/profile.h).
+    std::map<std::string, std::uint32_t> sideFeatures;
+    // Contour feature vertices on the front and side outlines.
+    std::vector<ContourVertex> frontContour;
+    std::vector<ContourVertex> sideContour;
+    // The point between the ear holes (the side photo's centre); the built-in head has it at the origin.
+    glm::dvec3 earHoleCentre{0.0};
+
+    // Midpoint of the two eye centres (mean of ibug 36-41 and of 42-47): the front photo's centre.
+    glm::dvec3 eyeMidpoint() const;
+};
+
+// The built-in base head, made by code (see base_head_generator.cpp for how, and how to make another).
+const BaseHead& builtinBaseHead();
+
+// Loads an operator's own base head: a glTF binary mesh (positions, UVs, one primitive) and a feature file
+// (JSON, the format written by saveBaseHead). Errors name the file and the field.
+BaseHead loadBaseHead(const std::filesystem::path& meshGlb, const std::filesystem::path& featureJson);
+
+// Writes the feature file of a base head (its mesh is written with the glb exporter).
+void saveFeatureFile(const BaseHead& head, const std::filesystem::path& featureJson);
+
+// Finds the contour vertices of a mesh seen orthographically along `viewAxis` (0 = from +z: front, 1 = from -x:
+// the subject's right side), by rays from `centre` (projected) at the given angles.
+std::vector<ContourVertex> findContourVertices(const Mesh& mesh, const glm::dvec3& centre, int viewAxis,
+                                               const std::vector<double>& anglesDeg);
+
+// The default ray angles for the front and side contours (the outline parts no landmark covers: the skull
+// over the top and sides for the front; forehead, top, back of the head and nape for the side).
+std::vector<double> defaultFrontContourAngles();
+std::vector<double> defaultSideContourAngles();
+
+}  // namespace avatarbooth

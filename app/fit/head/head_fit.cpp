@@ -1,0 +1,302 @@
+// NTT fitting: scale the base head per axis, measure feature and contour points, warp by RBFs, merge the views.
+#include "fit/head/head_fit.h"
+
+#include "common/error.h"
+#include "common/landmark_names.h"
+#include "fit/head/head_views.h"
+
+#include <opencv2/core.hpp>
+
+#include <cmath>
+#include <optional>
+#include <set>
+
+namespace avatarbooth {
+namespace {
+
+cv::Point2d mean(const std::map<std::string, cv::Point2d>& points, int from, int to) {
+    cv::Point2d sum(0, 0);
+    for (int k = from; k <= to; ++k) sum += points.at(landmarkName(k));
+    return sum * (1.0 / (to - from + 1));
+}
+
+glm::dvec3 meanVertex(const Mesh& mesh, const BaseHead& base, int from, int to) {
+    glm::dvec3 sum(0.0);
+    for (int k = from; k <= to; ++k) sum += mesh.positions[base.frontFeatures.at(landmarkName(k))];
+    return sum / static_cast<double>(to - from + 1);
+}
+
+// Walks from `start` along `dir` (pixels) and returns the last pixel inside the mask before it is left; this is
+// where a half-line from the view's centre crosses the head's outline (METHODS §1 step 4).
+cv::Point2d outlineCrossing(const cv::Mat& mask, const cv::Point2d& start, const cv::Point2d& dir, const char* view) {
+    const double len = std::hypot(dir.x, dir.y);
+    const cv::Point2d step = dir * (0.5 / len);
+    cv::Point2d p = start, lastInside = start;
+    bool wasInside = false;
+    const double maxSteps = 2.0 * (mask.cols + mask.rows);
+    for (int i = 0; i < maxSteps; ++i, p += step) {
+        const int x = static_cast<int>(std::lround(p.x)), y = static_cast<int>(std::lround(p.y));
+        const bool inside = x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<unsigned char>(y, x) != 0;
+        if (inside) {
+            lastInside = p;
+            wasInside = true;
+        } else if (wasInside) {
+            return lastInside;
+        } else if (i > 20) {
+            break;
+        }
+    }
+    throw BoothError(ErrorKind::NoFace, "", std::string("the head's outline was not found in the ") + view +
+                                                " photo (the silhouette does not contain the head's centre)");
+}
+
+// Where a half-line from `start` along `dir` first crosses the polyline through `points` (in order), if it does.
+std::optional<cv::Point2d> polylineCrossing(const std::vector<cv::Point2d>& points, const cv::Point2d& start,
+                                            const cv::Point2d& dir) {
+    std::optional<cv::Point2d> best;
+    double bestT = 1e300;
+    for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+        const cv::Point2d a = points[i], e = points[i + 1] - points[i];
+        const double den = dir.x * e.y - dir.y * e.x;
+        if (std::abs(den) < 1e-12) continue;
+        const cv::Point2d w = a - start;
+        const double t = (w.x * e.y - w.y * e.x) / den;  // along the ray
+        const double s = (w.x * dir.y - w.y * dir.x) / den;  // along the segment
+        if (t > 0.0 && s >= 0.0 && s <= 1.0 && t < bestT) {
+            bestT = t;
+            best = start + dir * t;
+        }
+    }
+    return best;
+}
+
+cv::Point2d mirrorPoint(const cv::Point2d& p, int width, bool mirror) {
+    return mirror ? cv::Point2d(width - 1 - p.x, p.y) : p;
+}
+
+const cv::Point2d& need(const std::map<std::string, cv::Point2d>& points, const std::string& name, const char* view) {
+    const auto it = points.find(name);
+    if (it == points.end())
+        throw BoothError(ErrorKind::NoFace, "", std::string("landmark '") + name + "' was not found in the " + view + " photo");
+    return it->second;
+}
+
+// The feature and contour vertices one view measures, with their targets in that view's plane (METHODS §1 steps
+// 3-4) and the displacements the RBF system of step 5 must reproduce. A vertex is measured once per view.
+struct ViewTargets {
+    explicit ViewTargets(View v) : view(v) {}
+    View view;
+    std::vector<glm::dvec3> centres;
+    std::vector<std::vector<double>> displacements;
+    std::vector<std::uint32_t> vertices;
+    std::vector<std::pair<std::string, glm::dvec2>> targets;
+    std::set<std::uint32_t> used;
+
+    void add(const Mesh& mesh, const std::string& name, std::uint32_t v, const glm::dvec2& target) {
+        if (!used.insert(v).second) return;
+        const glm::dvec3 c = mesh.positions[v];
+        const glm::dvec2 now = projectToView(c, view);
+        centres.push_back(c);
+        displacements.push_back({target.x - now.x, target.y - now.y});
+        vertices.push_back(v);
+        targets.emplace_back(name, target);
+    }
+};
+
+}  // namespace
+
+glm::dvec2 PhotoFrame::toHead(const cv::Point2d& px) const {
+    const double u = mirrored ? imageWidth - 1 - px.x : px.x;
+    return {(u - centrePx.x) * mmPerPixel + offsetMm.x, -(px.y - centrePx.y) * mmPerPixel + offsetMm.y};
+}
+
+cv::Point2d PhotoFrame::toPixel(const glm::dvec2& head) const {
+    const double u = (head.x - offsetMm.x) / mmPerPixel + centrePx.x;
+    return {mirrored ? imageWidth - 1 - u : u, -(head.y - offsetMm.y) / mmPerPixel + centrePx.y};
+}
+
+HeadFitOptions defaultHeadFitOptions() {
+    HeadFitOptions o;
+    // The chin (8), brows, nose, eyes and the outer lips. Not the other jaw points: dlib places them on the visible
+    // cheek outline, which is no fixed point of the head (it moves with the face's fullness and the slightest
+    // turn); with them the synthetic visitor's detected-landmark fit measured 3.4 % of head height, without 2.6 %.
+    // (They still give the head's width for the scaling step.) Not the inner lips, which follow the mouth's opening.
+    o.frontLandmarks.push_back(8);
+    for (int k = 17; k < 60; ++k) o.frontLandmarks.push_back(k);
+    return o;
+}
+
+HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const HeadFitOptions& options) {
+    HeadFit fit;
+    const Mesh& b = base.mesh;
+    const auto& fp = photos.frontPoints;
+    for (int k = 0; k < 68; ++k) need(fp, landmarkName(k), "front");
+    if (photos.frontMask.empty() || photos.sideMask.empty())
+        throw BoothError(ErrorKind::Internal, "", "fitHead needs both silhouettes");
+
+    // --- Front frame. Absolute size: the visitor's eyes are taken to be as far apart as the base head's (the
+    // one length orthographic photos cannot give); every other length is measured relative to it.
+    const cv::Point2d eyeMidPx = mean(fp, 36, 47);
+    const double ipdPx = cv::norm(mean(fp, 36, 41) - mean(fp, 42, 47));
+    const double ipdBase = glm::distance(meanVertex(b, base, 36, 41), meanVertex(b, base, 42, 47));
+    if (ipdPx < 4.0) throw BoothError(ErrorKind::NoFace, "", "the eyes in the front photo are too close together to measure");
+    const double frontMmPerPx = ipdBase / ipdPx;
+    // Relative to the eye midpoint, before the base head's position is known.
+    const auto frontRel = [&](const cv::Point2d& px) {
+        return glm::dvec2((px.x - eyeMidPx.x) * frontMmPerPx, -(px.y - eyeMidPx.y) * frontMmPerPx);
+    };
+    const cv::Point2d topPx = outlineCrossing(photos.frontMask, eyeMidPx, {0.0, -1.0}, "front");
+
+    // --- Side frame: mirror so the face points right, then tie the rows to the front's heights through points
+    // both photos show (least squares y = a v + b): top of head, nasion, nose tip, subnasale, upper lip.
+    const bool mirror = !photos.sideNoseImageRight;
+    const int sideWidth = photos.sideMask.cols;
+    cv::Mat sideMask;
+    if (mirror) cv::flip(photos.sideMask, sideMask, 1); else sideMask = photos.sideMask;
+    const auto side = [&](const std::string& name) { return mirrorPoint(need(photos.sidePoints, name, "side"), sideWidth, mirror); };
+    const std::pair<const char*, glm::dvec2> ties[] = {
+        {"top_of_head", frontRel(topPx)},          {"nasion", frontRel(fp.at(landmarkName(27)))},
+        {"nose_tip", frontRel(fp.at(landmarkName(30)))},    {"subnasale", frontRel(fp.at(landmarkName(33)))},
+        {"upper_lip", frontRel(fp.at(landmarkName(51)))},
+    };
+    cv::Mat A(5, 2, CV_64F), Y(5, 1, CV_64F);
+    for (int i = 0; i < 5; ++i) {
+        A.at<double>(i, 0) = side(ties[i].first).y;
+        A.at<double>(i, 1) = 1.0;
+        Y.at<double>(i, 0) = ties[i].second.y;
+    }
+    cv::Mat ab;
+    cv::solve(A, Y, ab, cv::DECOMP_SVD);
+    const double a = ab.at<double>(0), bOffset = ab.at<double>(1);
+    const double sideMmPerPx = -a;
+    const double ratio = sideMmPerPx / frontMmPerPx;
+    if (!(ratio > 1.0 / options.maxScaleRatio && ratio < options.maxScaleRatio))
+        throw BoothError(ErrorKind::Mismatch, "",
+                         "the head in the side photo is " + std::to_string(static_cast<int>(std::lround(100.0 / ratio))) +
+                             "% the size of the head in the front photo: the photos do not show the same person from the "
+                             "same distance");
+    double tieError = 0.0;
+    for (int i = 0; i < 5; ++i) {
+        const double e = a * side(ties[i].first).y + bOffset - ties[i].second.y;
+        tieError += e * e;
+    }
+    tieError = std::sqrt(tieError / 5.0);
+
+    // --- Step 2: per-axis scale of the base head from the measured extents, about the ear-hole centre.
+    const auto pos = [&](const std::string& name) { return b.positions[base.sideFeatures.at(name)]; };
+    const glm::dvec3 chinB = b.positions[base.frontFeatures.at(landmarkName(8))];
+    const double heightPhoto = frontRel(topPx).y - frontRel(fp.at(landmarkName(8))).y;
+    const double heightBase = pos("top_of_head").y - chinB.y;
+    const double widthPhoto = std::abs(frontRel(fp.at(landmarkName(16))).x - frontRel(fp.at(landmarkName(0))).x);
+    const double widthBase = std::abs(b.positions[base.frontFeatures.at(landmarkName(16))].x - b.positions[base.frontFeatures.at(landmarkName(0))].x);
+    const double depthPhoto = (side("glabella").x - side("back_of_head").x) * sideMmPerPx;
+    const double depthBase = pos("glabella").z - pos("back_of_head").z;
+    fit.axisScale = glm::dvec3(widthPhoto / widthBase, heightPhoto / heightBase, depthPhoto / depthBase);
+    for (int c = 0; c < 3; ++c)
+        if (!(fit.axisScale[c] > 0.6 && fit.axisScale[c] < 1.6))
+            throw BoothError(ErrorKind::Mismatch, "",
+                             std::string("the measured head ") + (c == 0 ? "width" : c == 1 ? "height" : "depth") +
+                                 " is " + std::to_string(fit.axisScale[c]) + " times the base head's: not a plausible head");
+    if (tieError > 0.06 * heightPhoto)
+        throw BoothError(ErrorKind::Mismatch, "",
+                         "the heights of the nose, lips and top of head disagree between the photos by " +
+                             std::to_string(static_cast<int>(tieError)) + " mm: they do not show the same head");
+    if (tieError > 0.025 * heightPhoto)
+        fit.warnings.push_back("shared heights between the photos disagree by " + std::to_string(tieError) + " mm (RMS)");
+    fit.scaledBase = b;
+    for (auto& p : fit.scaledBase.positions) p = base.earHoleCentre + (p - base.earHoleCentre) * fit.axisScale;
+    const Mesh& s = fit.scaledBase;
+    const glm::dvec3 eyeMidScaled = meanVertex(s, base, 36, 47);
+    const glm::dvec3 earScaled = base.earHoleCentre;  // the scaling's fixed point
+
+    fit.front = PhotoFrame{eyeMidPx, frontMmPerPx, {eyeMidScaled.x, eyeMidScaled.y}, false, photos.frontMask.cols};
+    const cv::Point2d earPx = side("ear_hole");
+    fit.side = PhotoFrame{cv::Point2d(earPx.x, earPx.y), sideMmPerPx, {earScaled.z, eyeMidScaled.y + a * earPx.y + bOffset},
+                          false, sideWidth};
+    // sideCanonical works on the mirrored image; fit.side takes raw photo pixels (it mirrors u first).
+    PhotoFrame sideCanonical = fit.side;
+    fit.side.mirrored = mirror;
+
+    // --- Steps 3-4: targets for the feature and contour vertices.
+    ViewTargets frontT(View::Front), sideT(View::Side);
+    const auto addFront = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) { frontT.add(s, name, v, target); };
+    const auto addSide = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) { sideT.add(s, name, v, target); };
+    for (const int k : options.frontLandmarks) {
+        const std::string name = landmarkName(k);
+        addFront(name, base.frontFeatures.at(name), fit.front.toHead(fp.at(name)));
+    }
+    // Below the eye line the silhouette can run on into hair, a collar or the shoulders. dlib's jaw line (points
+    // 0..16, a little inside the true outline: it follows the cheek) says where the face's own outline must be; a
+    // crossing much farther out than it is not the face, and that ray measures nothing.
+    std::vector<cv::Point2d> jawLine;
+    for (int k = 0; k <= 16; ++k) jawLine.push_back(fp.at(landmarkName(k)));
+    constexpr double kOutlineBeyondJaw = 1.4;
+    for (const auto& cv : base.frontContour) {
+        const glm::dvec3 p = s.positions[cv.vertex];
+        const cv::Point2d dir(p.x - eyeMidScaled.x, -(p.y - eyeMidScaled.y));
+        const cv::Point2d hit = outlineCrossing(photos.frontMask, eyeMidPx, dir, "front");
+        if (cv.angleDeg > 180.0) {
+            const auto onJaw = polylineCrossing(jawLine, eyeMidPx, dir);
+            if (!onJaw || cv::norm(hit - eyeMidPx) > kOutlineBeyondJaw * cv::norm(*onJaw - eyeMidPx)) continue;
+        }
+        fit.frontRays.emplace_back(eyeMidPx, hit);
+        addFront("front_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, fit.front.toHead(hit));
+    }
+    for (const auto& [name, v] : base.sideFeatures) {
+        const auto it = photos.sidePoints.find(name);
+        if (it == photos.sidePoints.end()) continue;
+        addSide(name, v, sideCanonical.toHead(mirrorPoint(it->second, sideWidth, mirror)));
+    }
+    const cv::Point2d earCanonical = earPx;
+    for (const auto& cv : base.sideContour) {
+        const glm::dvec3 p = s.positions[cv.vertex];
+        const glm::dvec2 earHead = sideCanonical.toHead(earCanonical);
+        const cv::Point2d dir(p.z - earHead.x, -(p.y - earHead.y));
+        const cv::Point2d hit = outlineCrossing(sideMask, earCanonical, dir, "side");
+        fit.sideRays.emplace_back(mirrorPoint(earCanonical, sideWidth, mirror), mirrorPoint(hit, sideWidth, mirror));
+        addSide("side_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, sideCanonical.toHead(hit));
+    }
+
+    // --- Step 5: the RBF warps, (x, y) from the front and (z, y) from the side, merged.
+    const RbfWarp frontWarp(frontT.centres, frontT.displacements, options.rbf);
+    const RbfWarp sideWarp(sideT.centres, sideT.displacements, options.rbf);
+    const auto normals = s.vertexNormals();
+    fit.mesh = s;
+    for (std::size_t i = 0; i < s.positions.size(); ++i) {
+        const glm::dvec3 p = s.positions[i];
+        const auto df = frontWarp.evaluate(p);
+        const auto ds = sideWarp.evaluate(p);
+        // y comes from both views: each weighs in by how squarely it sees the surface there (|n_z| for the
+        // front, |n_x| for the side), half and half where neither does (the top of the head).
+        const double nz = std::abs(normals[i].z), nx = std::abs(normals[i].x);
+        const double wFront = (nz + 0.01) / (nz + nx + 0.02);
+        fit.mesh.positions[i] = p + glm::dvec3(df[0], wFront * df[1] + (1.0 - wFront) * ds[1], ds[0]);
+    }
+    // The blend leaves feature vertices a little off their measured y. A last warp over all feature vertices (with
+    // the same kernel) moves each onto its y exactly; a vertex measured in both photos takes the mean of the two.
+    std::map<std::uint32_t, std::pair<double, int>> yTargets;
+    for (const ViewTargets* view : {&frontT, &sideT})
+        for (std::size_t k = 0; k < view->vertices.size(); ++k) {
+            auto& t = yTargets[view->vertices[k]];
+            t.first += view->targets[k].second.y;
+            ++t.second;
+        }
+    std::vector<glm::dvec3> yCentres;
+    std::vector<std::vector<double>> yDisp;
+    for (const auto& [v, t] : yTargets) {
+        yCentres.push_back(fit.mesh.positions[v]);
+        yDisp.push_back({t.first / t.second - fit.mesh.positions[v].y});
+    }
+    const RbfWarp yWarp(yCentres, yDisp, options.rbf);
+    for (auto& p : fit.mesh.positions) p.y += yWarp.evaluate(p)[0];
+
+    for (const ViewTargets* view : {&frontT, &sideT})
+        for (std::size_t k = 0; k < view->vertices.size(); ++k) {
+            const glm::dvec2 q = projectToView(fit.mesh.positions[view->vertices[k]], view->view);
+            const glm::dvec2 t = view->targets[k].second;
+            fit.residuals.push_back({view->targets[k].first, view->view == View::Front ? "front" : "side", t, q, glm::distance(t, q)});
+        }
+    return fit;
+}
+
+}  // namespace avatarbooth

@@ -1,0 +1,72 @@
+// Fitting the base head to a front and a side photo's measurements (METHODS §1 steps 2-5): per-axis scaling from
+// the measured extents, contour points by rays, and the RBF warp of (x, y) from the front and (z, y) from the side.
+#pragma once
+
+#include "fit/head/base_head.h"
+#include "fit/head/rbf.h"
+
+#include <opencv2/core.hpp>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace avatarbooth {
+
+// What the photos say, in pixels (pixel centres at integer coordinates, as OpenCV and dlib).
+struct PhotoMeasurements {
+    std::map<std::string, cv::Point2d> frontPoints;  // ibug_00 .. ibug_67
+    cv::Mat frontMask;                                // CV_8U silhouette of the person in the front photo
+    std::map<std::string, cv::Point2d> sidePoints;   // profile landmarks (nose_tip, ...), in the side photo as taken
+    cv::Mat sideMask;                                 // CV_8U silhouette in the side photo as taken
+    bool sideNoseImageRight = true;                   // false: the side photo is mirrored before use
+};
+
+struct HeadFitOptions {
+    RbfOptions rbf;
+    // Which front landmarks pull the head (default: see defaultHeadFitOptions()).
+    std::vector<int> frontLandmarks;
+    // Accepted ratio between the two photos' scales before they are called a mismatch.
+    double maxScaleRatio = 1.35;
+};
+
+HeadFitOptions defaultHeadFitOptions();
+
+// One feature point: where the fitted head put it against where the photo measured it (millimetres).
+struct FeatureResidual {
+    std::string name;
+    std::string view;  // "front" or "side"
+    glm::dvec2 measured{0.0};
+    glm::dvec2 fitted{0.0};
+    double errorMm = 0.0;
+};
+
+// How a photo pixel maps to head space: front (x, y) = ((u - centre.x) * mmPerPixel + offset.x,
+// -(v - centre.y) * mmPerPixel + offset.y); side likewise for (z, y), after mirroring when needed.
+struct PhotoFrame {
+    cv::Point2d centrePx;
+    double mmPerPixel = 1.0;
+    glm::dvec2 offsetMm{0.0};
+    bool mirrored = false;   // side photo: u is mirrored (u' = width - 1 - u) first
+    int imageWidth = 0;
+
+    glm::dvec2 toHead(const cv::Point2d& px) const;
+    cv::Point2d toPixel(const glm::dvec2& head) const;
+};
+
+struct HeadFit {
+    Mesh mesh;                   // the fitted head (base head topology)
+    Mesh scaledBase;             // the base head after step 2 (per-axis scaling), before the warp
+    glm::dvec3 axisScale{1.0};   // sx, sy, sz of step 2
+    PhotoFrame front, side;
+    std::vector<FeatureResidual> residuals;
+    // Contour rays for the overlays: from the view's centre to the measured outline point (pixels).
+    std::vector<std::pair<cv::Point2d, cv::Point2d>> frontRays, sideRays;
+    std::vector<std::string> warnings;
+};
+
+// Throws BoothError(Mismatch) when the photos disagree (scale ratio, shared heights), NoFace when a needed
+// landmark or outline is missing.
+HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const HeadFitOptions& options);
+
+}  // namespace avatarbooth

@@ -1,0 +1,538 @@
+// Photo texturing: per-photo visibility (z-buffers), one photo per texel, colour matching, a multi-band seam, fill.
+//
+// Why one photo per texel and not a weighted mean of both: the two photos are registered to the surface through
+// different coordinates (the front through x and y, the side through z and y), and off the profile line the fitted
+// z is the base head's guess. Where both were averaged, the side photo's lips and brows landed a few millimetres
+// from the front photo's and showed as a second, ghosted copy. A hard choice keeps every feature from one photo;
+// the multi-band blend then hides the seam: low frequencies (exposure, white balance, shading) cross it over a wide
+// band, fine detail switches at it.
+#include "fit/head/photo_texture.h"
+
+#include "common/error.h"
+#include "fit/head/surface_texels.h"
+#include "fit/head/view_depth.h"
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/stitching/detail/blenders.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace avatarbooth {
+
+void pullPushFill(cv::Mat& colour, cv::Mat& weight) {
+    // Pull: average known texels (premultiplied by their weight) into ever coarser levels. Push: give each unknown
+    // texel of a finer level the (bilinearly upsampled) colour of the level below it, so holes take a smooth mean
+    // of what surrounds them.
+    if (colour.type() != CV_32FC3 || weight.type() != CV_32F || colour.size() != weight.size())
+        throw BoothError(ErrorKind::Internal, "", "pull-push fill: needs CV_32FC3 colours and CV_32F weights of one size");
+    if (colour.empty()) return;
+    std::vector<cv::Mat> pyramid(1);
+    pyramid[0].create(colour.size(), CV_32FC4);
+    for (int y = 0; y < colour.rows; ++y) {
+        const cv::Vec3f* c = colour.ptr<cv::Vec3f>(y);
+        const float* w = weight.ptr<float>(y);
+        cv::Vec4f* p = pyramid[0].ptr<cv::Vec4f>(y);
+        for (int x = 0; x < colour.cols; ++x) {
+            const float a = std::clamp(w[x], 0.0f, 1.0f);
+            p[x] = cv::Vec4f(c[x][0] * a, c[x][1] * a, c[x][2] * a, a);
+        }
+    }
+    while (pyramid.back().rows > 1 || pyramid.back().cols > 1) {
+        const cv::Mat& fine = pyramid.back();
+        cv::Mat coarse;
+        cv::resize(fine, coarse, cv::Size((fine.cols + 1) / 2, (fine.rows + 1) / 2), 0, 0, cv::INTER_AREA);
+        pyramid.push_back(coarse);
+    }
+    // Push, coarsest first. Above the finest level a texel with any known content counts as known (its normalised
+    // colour), which keeps the fill from washing out towards the holes' middle.
+    cv::Mat filled;  // CV_32FC3, the level below, complete
+    for (int level = static_cast<int>(pyramid.size()) - 1; level >= 0; --level) {
+        const cv::Mat& p = pyramid[static_cast<std::size_t>(level)];
+        cv::Mat up;
+        if (!filled.empty()) cv::resize(filled, up, p.size(), 0, 0, cv::INTER_LINEAR);
+        cv::Mat out(p.size(), CV_32FC3);
+        for (int y = 0; y < p.rows; ++y) {
+            const cv::Vec4f* q = p.ptr<cv::Vec4f>(y);
+            const cv::Vec3f* u = up.empty() ? nullptr : up.ptr<cv::Vec3f>(y);
+            cv::Vec3f* o = out.ptr<cv::Vec3f>(y);
+            const cv::Vec3f* original = level == 0 ? colour.ptr<cv::Vec3f>(y) : nullptr;
+            for (int x = 0; x < p.cols; ++x) {
+                const float a = q[x][3];
+                const cv::Vec3f below = u ? u[x] : cv::Vec3f(0, 0, 0);
+                if (level == 0) {
+                    o[x] = original[x] * a + below * (1.0f - a);
+                } else if (a > 1e-6f) {
+                    o[x] = cv::Vec3f(q[x][0], q[x][1], q[x][2]) / a;
+                } else {
+                    o[x] = below;
+                }
+            }
+        }
+        filled = out;
+    }
+    colour = filled;
+    weight.setTo(1.0f);
+}
+
+namespace {
+
+// Rings of neighbours the normals that choose between the photos are averaged over (the face's grid spacing is
+// 2-3 mm, so about a centimetre).
+constexpr int kDecisionRings = 4;
+// Seen more obliquely than this (about 80 degrees), a photo's pixel smears over many texels: not used.
+constexpr float kMinCosine = 0.17f;
+
+// What the texture step needs of one vertex, in both views. Everything a texel needs is interpolated from its
+// triangle's three vertices (the views are orthographic, so positions and depths are exactly linear; the cosines
+// and tolerances nearly so), which keeps square roots and divisions out of the million-texel loops.
+struct VertexViews {
+    float fu, fv, su, sv;  // front and side photo pixels (pixel centres at integers)
+    float z, x;            // depth towards the front camera (z) and towards the +x side camera (x)
+    float cosFront;        // normal . (0, 0, 1)
+    float cosSide;         // normal . (1, 0, 0): its sign says which side camera faces the surface
+    float tolFront, tolSide;  // depth tolerances of the visibility tests, millimetres
+    float frontBetter;     // > 0 where the front photo is to be preferred (from the smoothed normals)
+};
+
+// A quantity that is affine in the texel position within one triangle: value = c + gx x + gy y for texel (x, y).
+struct Affine {
+    float c = 0, gx = 0, gy = 0;
+    float at(float x, float y) const { return c + gx * x + gy * y; }
+};
+struct TexelToPhoto {
+    Affine fu, fv, su, sv;
+};
+
+// Vertex normals averaged over a few rings of neighbours. They decide which photo a texel takes: the fitted mesh has
+// creases (where the base head's parts meet, the nose's and lips' rims) whose normals turn sideways over a few
+// millimetres, and with the texel's own normal those thin strips went to the side photo and carried its lips and
+// nose edges into the face as slivers.
+std::vector<glm::dvec3> smoothedNormals(const Mesh& mesh, std::vector<glm::dvec3> normals, int rings) {
+    std::vector<glm::dvec3> sum(normals.size());
+    for (int ring = 0; ring < rings; ++ring) {
+        sum = normals;
+        for (const auto& t : mesh.triangles) {
+            const std::uint32_t v[3] = {t.x, t.y, t.z};
+            for (int k = 0; k < 3; ++k) sum[v[k]] += normals[v[(k + 1) % 3]] + normals[v[(k + 2) % 3]];
+        }
+        for (std::size_t i = 0; i < normals.size(); ++i) {
+            const double length = glm::length(sum[i]);
+            normals[i] = length > 1e-12 ? sum[i] / length : normals[i];
+        }
+    }
+    return normals;
+}
+
+// Bilinear sample of an 8-bit BGR photo at (u, v), pixel centres at integers. The caller has checked that the
+// nearest pixel is inside the photo, so u, v >= -0.5 (truncation is then a floor, after the clamp to 0). Fixed-point
+// weights (1/128): this runs a million times per texture, and byte-to-float conversions were its main cost.
+inline cv::Vec3f bilinear(const cv::Mat& photo, float u, float v) {
+    const int x0 = std::min(static_cast<int>(std::max(u, 0.0f)), photo.cols - 2);
+    const int y0 = std::min(static_cast<int>(std::max(v, 0.0f)), photo.rows - 2);
+    const int wx = static_cast<int>(std::clamp(u - static_cast<float>(x0), 0.0f, 1.0f) * 128.0f + 0.5f);
+    const int wy = static_cast<int>(std::clamp(v - static_cast<float>(y0), 0.0f, 1.0f) * 128.0f + 0.5f);
+    const unsigned char* a = photo.ptr<unsigned char>(y0) + 3 * x0;
+    const unsigned char* b = a + photo.step[0];
+    cv::Vec3f out;
+    for (int c = 0; c < 3; ++c) {
+        const int top = a[c] * (128 - wx) + a[c + 3] * wx;
+        const int bottom = b[c] * (128 - wx) + b[c + 3] * wx;
+        out[c] = static_cast<float>(top * (128 - wy) + bottom * wy) * (1.0f / 16384.0f);
+    }
+    return out;
+}
+
+// Bilinear upsampling by two of a CV_32FC3 image, one full-resolution row at a time (full-resolution texel centre
+// x + 0.5 is at half-resolution x / 2 - 0.25): the columns' taps are computed once.
+class HalfToFull {
+public:
+    HalfToFull(cv::Size half, int fullWidth) : half_(half), taps_(static_cast<std::size_t>(fullWidth)) {
+        for (int x = 0; x < fullWidth; ++x) taps_[static_cast<std::size_t>(x)] = tap(x, half.width);
+    }
+    // Row y of the upsampled image, as two half-resolution rows and the weight of the second.
+    void row(const cv::Mat& image, int y, const cv::Vec3f*& r0, const cv::Vec3f*& r1, float& fy) const {
+        const Tap t = tap(y, half_.height);
+        r0 = image.ptr<cv::Vec3f>(t.i0);
+        r1 = image.ptr<cv::Vec3f>(t.i1);
+        fy = t.f;
+    }
+    cv::Vec3f at(const cv::Vec3f* r0, const cv::Vec3f* r1, float fy, int x) const {
+        const Tap& t = taps_[static_cast<std::size_t>(x)];
+        const cv::Vec3f top = r0[t.i0] + (r0[t.i1] - r0[t.i0]) * t.f;
+        const cv::Vec3f bottom = r1[t.i0] + (r1[t.i1] - r1[t.i0]) * t.f;
+        return top + (bottom - top) * fy;
+    }
+
+private:
+    struct Tap {
+        int i0, i1;
+        float f;
+    };
+    static Tap tap(int full, int halfLength) {
+        const float h = static_cast<float>(full) * 0.5f - 0.25f;
+        const int i0 = std::clamp(static_cast<int>(std::floor(h)), 0, halfLength - 1);
+        const int i1 = std::min(i0 + 1, halfLength - 1);
+        return {i0, i1, std::clamp(h - static_cast<float>(i0), 0.0f, 1.0f)};
+    }
+    cv::Size half_;
+    std::vector<Tap> taps_;
+};
+
+// A silhouette shrunk by two pixels: photo pixels at the outline are part background, and a texel that samples
+// them takes a dark fringe (the profile's edge showed as dark lines across the lips and brows).
+cv::Mat interiorOf(const cv::Mat& mask) {
+    cv::Mat inner;
+    cv::erode(mask, inner, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
+    return inner;
+}
+
+// The per-texel decision, shared by the half- and the full-resolution pass.
+struct TexelView {
+    bool seenFront = false, seenSide = false, frontChosen = false, facesFront = false;
+    float fu = 0, fv = 0, su = 0, sv = 0;
+    float cosFront = 0, cosSide = 0;
+};
+
+class TexelClassifier {
+public:
+    TexelClassifier(const Mesh& mesh, const std::vector<VertexViews>& views, const std::array<cv::Mat, 3>& depth,
+                    const cv::Mat& frontInner, const cv::Mat& sideInner)
+        : mesh_(mesh), views_(views), depth_(depth), frontInner_(frontInner), sideInner_(sideInner) {}
+
+    TexelView operator()(int triangle, float b0, float b1) const {
+        const glm::uvec3& t = mesh_.triangles[static_cast<std::size_t>(triangle)];
+        const float b2 = 1.0f - b0 - b1;
+        const VertexViews& A = views_[t.x];
+        const VertexViews& B = views_[t.y];
+        const VertexViews& C = views_[t.z];
+        const auto mix = [&](float VertexViews::*m) { return b0 * A.*m + b1 * B.*m + b2 * C.*m; };
+        TexelView v;
+        v.fu = mix(&VertexViews::fu);
+        v.fv = mix(&VertexViews::fv);
+        v.su = mix(&VertexViews::su);
+        v.sv = mix(&VertexViews::sv);
+        v.cosFront = mix(&VertexViews::cosFront);
+        const float cosSide = mix(&VertexViews::cosSide);
+        v.cosSide = std::abs(cosSide);
+        v.facesFront = v.cosFront > v.cosSide;
+        if (v.cosFront > kMinCosine)
+            v.seenFront = visible(depth_[0], frontInner_, v.fu, v.fv, mix(&VertexViews::z), mix(&VertexViews::tolFront));
+        // The side camera on the side the surface faces: -x is the side photo's own view, +x its mirror image.
+        if (v.cosSide > kMinCosine) {
+            const float x = mix(&VertexViews::x);
+            v.seenSide = cosSide < 0.0f ? visible(depth_[1], sideInner_, v.su, v.sv, -x, mix(&VertexViews::tolSide))
+                                        : visible(depth_[2], sideInner_, v.su, v.sv, x, mix(&VertexViews::tolSide));
+        }
+        v.frontChosen = v.seenFront && (!v.seenSide || mix(&VertexViews::frontBetter) >= 0.0f);
+        return v;
+    }
+
+private:
+    // Inside the silhouette, and no surface nearer the camera than this one at its pixel (the z-buffer is read at the
+    // nearest pixel centre; the tolerance covers the surface's slope over that distance).
+    static bool visible(const cv::Mat& z, const cv::Mat& mask, float u, float v, float depth, float tolerance) {
+        if (!(u >= -0.5f && v >= -0.5f)) return false;  // (also rejects NaN)
+        const int x = static_cast<int>(u + 0.5f), y = static_cast<int>(v + 0.5f);
+        if (x >= z.cols || y >= z.rows) return false;
+        return mask.ptr<unsigned char>(y)[x] != 0 && depth >= z.ptr<float>(y)[x] - tolerance;
+    }
+
+    const Mesh& mesh_;
+    const std::vector<VertexViews>& views_;
+    const std::array<cv::Mat, 3>& depth_;
+    const cv::Mat& frontInner_;
+    const cv::Mat& sideInner_;
+};
+
+inline cv::Vec3b toBgr(const cv::Vec3f& c) {
+    return {cv::saturate_cast<unsigned char>(c[0]), cv::saturate_cast<unsigned char>(c[1]), cv::saturate_cast<unsigned char>(c[2])};
+}
+
+}  // namespace
+
+void prepareTexture(const Mesh& mesh, const PhotoTextureOptions& options) {
+    if (options.size < 16) throw BoothError(ErrorKind::Internal, "", "texture: the size must be at least 16 texels");
+    cachedTexelMap(mesh, cv::Size(options.size, options.size));
+    cachedTexelMap(mesh, cv::Size((options.size + 1) / 2, (options.size + 1) / 2));
+}
+
+PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
+                               const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options) {
+    if (front.empty() || side.empty() || front.type() != CV_8UC3 || side.type() != CV_8UC3 || front.cols < 2 ||
+        front.rows < 2 || side.cols < 2 || side.rows < 2)
+        throw BoothError(ErrorKind::Internal, "", "texture: the photos must be 8-bit BGR");
+    if (frontMask.size() != front.size() || sideMask.size() != side.size() || frontMask.type() != CV_8U || sideMask.type() != CV_8U)
+        throw BoothError(ErrorKind::Internal, "", "texture: each silhouette must be an 8-bit mask of its photo's size");
+    if (options.size < 16) throw BoothError(ErrorKind::Internal, "", "texture: the size must be at least 16 texels");
+    if (fitted.uvs.size() != fitted.positions.size())
+        throw BoothError(ErrorKind::Internal, "", "texture: the mesh has no texture coordinates");
+    const cv::Size size(options.size, options.size);
+    const cv::Size half((size.width + 1) / 2, (size.height + 1) / 2);
+    // Which triangle covers each texel depends only on the UV layout: computed once per base head and size.
+    const TexelMap& map = cachedTexelMap(fitted, size);
+    const TexelMap& halfMap = cachedTexelMap(fitted, half);
+
+    // --- Each vertex in both views, and a z-buffer per camera: front (+z), the side photo's own side (-x), and the
+    // other side (+x), which the side photo stands in for, mirrored. Orthographic views make the depth linear.
+    const float strictness = static_cast<float>(options.angleStrictness);
+    const auto weightOf = [strictness](double c) { return std::pow(std::max(c, 0.0), static_cast<double>(strictness)); };
+    const double baseTolerance = options.depthToleranceMm;
+    // A visible point's depth differs from the z-buffer at the nearest pixel centre by up to its slope times that
+    // distance (under a pixel): allow 1.5 pixels of slope, capped where the photo sees the surface edge-on.
+    const auto tolerance = [baseTolerance](double cosine, double mmPerPixel) {
+        const double c = std::clamp(std::abs(cosine), 1e-3, 1.0);
+        return static_cast<float>(baseTolerance + 1.5 * mmPerPixel * std::min(std::sqrt(1.0 - c * c) / c, 4.0));
+    };
+    const std::vector<glm::dvec3> normals = fitted.vertexNormals();
+    const std::vector<glm::dvec3> smooth = smoothedNormals(fitted, normals, kDecisionRings);
+    std::vector<VertexViews> views(fitted.positions.size());
+    std::array<std::vector<ViewVertex>, 3> depthVertices;  // front, from -x, from +x
+    for (auto& d : depthVertices) d.resize(fitted.positions.size());
+    for (std::size_t i = 0; i < fitted.positions.size(); ++i) {
+        const glm::dvec3& p = fitted.positions[i];
+        const cv::Point2d f = fit.front.toPixel({p.x, p.y});
+        const cv::Point2d s = fit.side.toPixel({p.z, p.y});
+        const glm::dvec3& n = normals[i];
+        const glm::dvec3& m = smooth[i];
+        VertexViews& v = views[i];
+        v.fu = static_cast<float>(f.x);
+        v.fv = static_cast<float>(f.y);
+        v.su = static_cast<float>(s.x);
+        v.sv = static_cast<float>(s.y);
+        v.z = static_cast<float>(p.z);
+        v.x = static_cast<float>(p.x);
+        v.cosFront = static_cast<float>(n.z);
+        v.cosSide = static_cast<float>(n.x);
+        v.tolFront = tolerance(n.z, fit.front.mmPerPixel);
+        v.tolSide = tolerance(n.x, fit.side.mmPerPixel);
+        v.frontBetter = static_cast<float>(options.frontPreference * weightOf(m.z) - weightOf(std::abs(m.x)));
+        depthVertices[0][i] = {v.fu, v.fv, v.z};
+        depthVertices[1][i] = {v.su, v.sv, -v.x};
+        depthVertices[2][i] = {v.su, v.sv, v.x};
+    }
+    // Each camera's z-buffer needs only the triangles facing it: on a closed surface the nearest one along any ray
+    // does (this halves the rasterising).
+    std::array<std::vector<glm::uvec3>, 3> facing;
+    for (const auto& t : fitted.triangles) {
+        const glm::dvec3& a = fitted.positions[t.x];
+        const glm::dvec3 n = glm::cross(fitted.positions[t.y] - a, fitted.positions[t.z] - a);
+        if (n.z > 0.0) facing[0].push_back(t);
+        if (n.x < 0.0) facing[1].push_back(t);
+        if (n.x > 0.0) facing[2].push_back(t);
+    }
+    // Where the front and the side photo pixels of a texel are, as an affine function of the texel's position per
+    // triangle (exact: UVs, barycentrics and orthographic projections are all affine): the full-resolution pass
+    // then reads one triangle's coefficients per texel instead of three vertices and the barycentric map.
+    std::vector<TexelToPhoto> toPhoto(fitted.triangles.size());
+    for (std::size_t ti = 0; ti < fitted.triangles.size(); ++ti) {
+        const glm::uvec3& t = fitted.triangles[ti];
+        const std::uint32_t idx[3] = {t.x, t.y, t.z};
+        glm::dvec2 p[3];
+        for (int k = 0; k < 3; ++k) p[k] = glm::dvec2(fitted.uvs[idx[k]].x * size.width, fitted.uvs[idx[k]].y * size.height);
+        const glm::dvec2 e1 = p[1] - p[0], e2 = p[2] - p[0];
+        const double det = e1.x * e2.y - e2.x * e1.y;
+        if (std::abs(det) < 1e-12) continue;  // degenerate in UV: no texel maps to it
+        const auto affine = [&](float VertexViews::*m) {
+            const double a0 = views[idx[0]].*m, d1 = views[idx[1]].*m - a0, d2 = views[idx[2]].*m - a0;
+            const double gx = (d1 * e2.y - d2 * e1.y) / det, gy = (d2 * e1.x - d1 * e2.x) / det;
+            // Texel (x, y) has its centre at (x + 0.5, y + 0.5): fold the half and the corner into the constant.
+            return Affine{static_cast<float>(a0 + gx * (0.5 - p[0].x) + gy * (0.5 - p[0].y)), static_cast<float>(gx),
+                          static_cast<float>(gy)};
+        };
+        toPhoto[ti] = {affine(&VertexViews::fu), affine(&VertexViews::fv), affine(&VertexViews::su), affine(&VertexViews::sv)};
+    }
+    std::array<cv::Mat, 3> depth;
+    std::array<cv::Mat, 2> inner;
+    cv::parallel_for_(cv::Range(0, 5), [&](const cv::Range& r) {
+        for (int k = r.start; k < r.end; ++k) {
+            const auto i = static_cast<std::size_t>(k);
+            if (k < 3) depth[i] = rasteriseNearestDepth(depthVertices[i], facing[i], k == 0 ? front.size() : side.size());
+            else inner[i - 3] = interiorOf(k == 3 ? frontMask : sideMask);
+        }
+    });
+    const TexelClassifier classify(fitted, views, depth, inner[0], inner[1]);
+
+    // --- Half resolution: both photos' colours wherever they see the surface (for the blend's coarse bands), the
+    // choice of photo as the blend's masks, and the exposure comparison. Rows in stripes over the two cores; sums
+    // per stripe, added up afterwards.
+    cv::Mat frontHalf(half, CV_32FC3, cv::Scalar::all(0)), sideHalf(half, CV_32FC3, cv::Scalar::all(0));
+    cv::Mat frontSeen(half, CV_32F, cv::Scalar(0)), sideSeen(half, CV_32F, cv::Scalar(0));
+    cv::Mat frontLabel(half, CV_8U, cv::Scalar(0));  // 255 where the blend takes the front photo's bands
+    cv::Mat halfSource(half, CV_8U, cv::Scalar(PhotoTexture::Filled));  // the photo each texel takes
+    constexpr int kStripes = 16;
+    std::array<cv::Vec3d, kStripes> frontSum{}, sideSum{};
+    std::array<long, kStripes> overlapCount{};
+    cv::parallel_for_(cv::Range(0, kStripes), [&](const cv::Range& stripes) {
+        for (int stripe = stripes.start; stripe < stripes.end; ++stripe) {
+            cv::Vec3d frontAcc(0, 0, 0), sideAcc(0, 0, 0);  // locals: neighbouring array entries share a cache line
+            long overlapAcc = 0;
+            for (int y = half.height * stripe / kStripes; y < half.height * (stripe + 1) / kStripes; ++y) {
+                const int* tri = halfMap.triangle.ptr<int>(y);
+                const cv::Vec2f* bary = halfMap.barycentric.ptr<cv::Vec2f>(y);
+                cv::Vec3f* fc = frontHalf.ptr<cv::Vec3f>(y);
+                cv::Vec3f* sc = sideHalf.ptr<cv::Vec3f>(y);
+                float* fw = frontSeen.ptr<float>(y);
+                float* sw = sideSeen.ptr<float>(y);
+                unsigned char* label = frontLabel.ptr<unsigned char>(y);
+                unsigned char* src = halfSource.ptr<unsigned char>(y);
+                for (int x = 0; x < half.width; ++x) {
+                    if (tri[x] < 0) continue;
+                    const TexelView v = classify(tri[x], bary[x][0], bary[x][1]);
+                    if (v.seenFront) {
+                        fc[x] = bilinear(front, v.fu, v.fv);
+                        fw[x] = 1.0f;
+                    }
+                    if (v.seenSide) {
+                        sc[x] = bilinear(side, v.su, v.sv);
+                        sw[x] = 1.0f;
+                    }
+                    // Unseen texels are filled; the fill there is blended from the photo the surface faces most.
+                    if (v.frontChosen || (!v.seenFront && !v.seenSide && v.facesFront)) label[x] = 255;
+                    src[x] = v.frontChosen ? PhotoTexture::Front : (v.seenSide ? PhotoTexture::Side : PhotoTexture::Filled);
+                    if (v.seenFront && v.seenSide && v.cosFront > 0.4f && v.cosSide > 0.4f) {
+                        frontAcc += cv::Vec3d(fc[x][0], fc[x][1], fc[x][2]);
+                        sideAcc += cv::Vec3d(sc[x][0], sc[x][1], sc[x][2]);
+                        ++overlapAcc;
+                    }
+                }
+            }
+            const auto s = static_cast<std::size_t>(stripe);
+            frontSum[s] = frontAcc;
+            sideSum[s] = sideAcc;
+            overlapCount[s] = overlapAcc;
+        }
+    }, kStripes);
+
+    // --- The photos differ in exposure and white balance: match the side photo's colour to the front's where both
+    // see the surface well (per-channel gain).
+    cv::Vec3d frontTotal(0, 0, 0), sideTotal(0, 0, 0);
+    long overlap = 0;
+    for (std::size_t s = 0; s < kStripes; ++s) {
+        frontTotal += frontSum[s];
+        sideTotal += sideSum[s];
+        overlap += overlapCount[s];
+    }
+    cv::Vec3f gain(1, 1, 1);
+    if (overlap > 50)
+        for (int c = 0; c < 3; ++c)
+            gain[c] = static_cast<float>(std::clamp(frontTotal[c] / std::max(sideTotal[c], 1.0), 0.6, 1.6));
+
+    // --- The multi-band blend. Its finest band switches at the seam; every coarser band is blended across it by
+    // OpenCV's MultiBandBlender, run at half resolution on the two photos' colours. At full resolution a texel then
+    // keeps its own photo's detail and takes the blended low frequencies:
+    //   out = own colour + up(blend - own photo at half resolution),
+    // which is the photo's colour exactly wherever the blend is all that photo's. Each photo's image is filled in
+    // beyond what it saw (pull-push: a smooth continuation), so that the blend's coarse bands, which reach far past
+    // the seam, meet plausible colours and no edge. (Filling one photo's gaps with the other photo's colours instead
+    // put a hard edge into both images where the two photos' grazing views meet, and no blend can smooth an edge
+    // both of its inputs have.)
+    cv::multiply(sideHalf, cv::Scalar(gain[0], gain[1], gain[2]), sideHalf);
+    const cv::Mat frontSeenHalf = frontSeen > 0.0f, sideSeenHalf = sideSeen > 0.0f;
+    cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& r) {
+        for (int k = r.start; k < r.end; ++k) pullPushFill(k == 0 ? frontHalf : sideHalf, k == 0 ? frontSeen : sideSeen);
+    });
+    cv::Mat blended;
+    {
+        cv::detail::MultiBandBlender blender(false, std::max(options.blendBands - 1, 1), CV_32F);
+        blender.prepare(cv::Rect(cv::Point(0, 0), half));
+        cv::Mat frontShort, sideShort, blendedShort, blendMask;
+        // The blender's pyramids are 16-bit integers and each level rounds: at 8-bit scale that biased the result
+        // by 1-3 levels even where both inputs were the same. Sixteen times the scale keeps 4 bits of fraction
+        // (255 * 16 and its band differences stay well inside 16 bits).
+        constexpr double kScale = 16.0;
+        frontHalf.convertTo(frontShort, CV_16SC3, kScale);
+        sideHalf.convertTo(sideShort, CV_16SC3, kScale);
+        blender.feed(frontShort, frontLabel, cv::Point(0, 0));
+        blender.feed(sideShort, 255 - frontLabel, cv::Point(0, 0));
+        blender.blend(blendedShort, blendMask);
+        blendedShort.convertTo(blended, CV_32FC3, 1.0 / kScale);
+    }
+    const cv::Mat frontCorrection = blended - frontHalf, sideCorrection = blended - sideHalf;
+    // Where a texel's half-resolution neighbours all took the same photo, the full-resolution texels among them
+    // take it too without testing visibility again (no occluder edge passes there); elsewhere each decides itself.
+    cv::Mat allFront, allSide;
+    cv::erode(halfSource == PhotoTexture::Front, allFront, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::erode(halfSource == PhotoTexture::Side, allSide, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+
+    // --- Full resolution: each texel decides again (visibility at its own point) and takes its photo's colour plus
+    // the blend's correction; texels no photo sees, and those no triangle covers (the UV borders, which mipmapping
+    // reads), take the blended fill.
+    PhotoTexture out;
+    out.texture.create(size, CV_8UC3);
+    out.source = cv::Mat(size, CV_8U, cv::Scalar(PhotoTexture::Filled));
+    std::array<int, kStripes> coveredCount{}, seenCount{};
+    const HalfToFull upsample(half, size.width);
+    cv::parallel_for_(cv::Range(0, kStripes), [&](const cv::Range& stripes) {
+        for (int stripe = stripes.start; stripe < stripes.end; ++stripe) {
+            int coveredAcc = 0, seenAcc = 0;
+            for (int y = size.height * stripe / kStripes; y < size.height * (stripe + 1) / kStripes; ++y) {
+                const int* tri = map.triangle.ptr<int>(y);
+                const cv::Vec2f* bary = map.barycentric.ptr<cv::Vec2f>(y);
+                unsigned char* src = out.source.ptr<unsigned char>(y);
+                cv::Vec3b* o = out.texture.ptr<cv::Vec3b>(y);
+                const cv::Vec3f *f0, *f1, *s0, *s1, *b0, *b1;
+                float fy = 0.0f;
+                upsample.row(frontCorrection, y, f0, f1, fy);
+                upsample.row(sideCorrection, y, s0, s1, fy);
+                upsample.row(blended, y, b0, b1, fy);
+                const unsigned char* uniformFront = allFront.ptr<unsigned char>(std::min(y / 2, half.height - 1));
+                const unsigned char* uniformSide = allSide.ptr<unsigned char>(std::min(y / 2, half.height - 1));
+                const unsigned char* frontSeenRow = frontSeenHalf.ptr<unsigned char>(std::min(y / 2, half.height - 1));
+                const unsigned char* sideSeenRow = sideSeenHalf.ptr<unsigned char>(std::min(y / 2, half.height - 1));
+                for (int x = 0; x < size.width; ++x) {
+                    if (tri[x] >= 0) {
+                        ++coveredAcc;
+                        const int hx = std::min(x / 2, half.width - 1);
+                        const float fx = static_cast<float>(x), fyRow = static_cast<float>(y);
+                        const TexelToPhoto& a = toPhoto[static_cast<std::size_t>(tri[x])];
+                        if (uniformFront[hx]) {
+                            o[x] = toBgr(bilinear(front, a.fu.at(fx, fyRow), a.fv.at(fx, fyRow)) + upsample.at(f0, f1, fy, x));
+                            src[x] = PhotoTexture::Front;
+                            ++seenAcc;
+                            continue;
+                        }
+                        if (uniformSide[hx]) {
+                            const cv::Vec3f c = bilinear(side, a.su.at(fx, fyRow), a.sv.at(fx, fyRow));
+                            o[x] = toBgr(cv::Vec3f(c[0] * gain[0], c[1] * gain[1], c[2] * gain[2]) + upsample.at(s0, s1, fy, x));
+                            src[x] = PhotoTexture::Side;
+                            ++seenAcc;
+                            continue;
+                        }
+                        // A texel takes a photo only where the half-resolution pass saw that photo too: its
+                        // correction subtracts that photo's half-resolution colour, which elsewhere is a stand-in
+                        // (the other photo's, or the fill), and the difference would show as a step.
+                        const TexelView v = classify(tri[x], bary[x][0], bary[x][1]);
+                        const bool frontThere = v.seenFront && frontSeenRow[hx], sideThere = v.seenSide && sideSeenRow[hx];
+                        if (frontThere && (v.frontChosen || !sideThere)) {
+                            o[x] = toBgr(bilinear(front, v.fu, v.fv) + upsample.at(f0, f1, fy, x));
+                            src[x] = PhotoTexture::Front;
+                            ++seenAcc;
+                            continue;
+                        }
+                        if (sideThere) {
+                            const cv::Vec3f c = bilinear(side, v.su, v.sv);
+                            o[x] = toBgr(cv::Vec3f(c[0] * gain[0], c[1] * gain[1], c[2] * gain[2]) + upsample.at(s0, s1, fy, x));
+                            src[x] = PhotoTexture::Side;
+                            ++seenAcc;
+                            continue;
+                        }
+                    }
+                    o[x] = toBgr(upsample.at(b0, b1, fy, x));
+                }
+            }
+            coveredCount[static_cast<std::size_t>(stripe)] = coveredAcc;
+            seenCount[static_cast<std::size_t>(stripe)] = seenAcc;
+        }
+    }, kStripes);
+    int covered = 0, seen = 0;
+    for (std::size_t s = 0; s < kStripes; ++s) {
+        covered += coveredCount[s];
+        seen += seenCount[s];
+    }
+    out.seenFraction = covered > 0 ? static_cast<double>(seen) / covered : 0.0;
+    return out;
+}
+
+}  // namespace avatarbooth

@@ -1,0 +1,55 @@
+// Texturing the fitted head from the two photos (METHODS §1 step 6, with §4's multi-view practice): every texel
+// takes its colour from the one photo that sees that surface point best, and the seam between the photos is
+// blended band by band (OpenCV's multi-band blender) so that it does not show and no feature is doubled.
+#pragma once
+
+#include "fit/head/head_fit.h"
+
+#include <opencv2/core.hpp>
+
+namespace avatarbooth {
+
+struct PhotoTextureOptions {
+    int size = 1024;
+    // Exponent on the cosine between surface normal and view direction: a photo's weight at a texel, which decides
+    // (with frontPreference) which of the two photos a texel both see takes.
+    double angleStrictness = 2.0;
+    // How much the front photo is preferred: a texel both photos see goes to the side photo only where the side
+    // weight exceeds frontPreference times the front weight (with cos^2 weights and 4: where the surface turns more
+    // than about 63 degrees from the front). The front photo is registered by 68 landmarks in (x, y); the side
+    // photo's colour lands through the fitted depth z, which off the profile line is the base head's guess, so on
+    // the face (cheeks by the nose and mouth) it is the less trustworthy of the two.
+    double frontPreference = 4.0;
+    // Bands of the multi-band blend across the seam (more = a wider, softer transition of the low frequencies): the
+    // finest switches at the seam at full resolution, the others are OpenCV's MultiBandBlender at half resolution.
+    int blendBands = 5;
+    // Depth tolerance of the visibility test in millimetres, on top of what the pixel size and slope allow.
+    double depthToleranceMm = 2.0;
+};
+
+struct PhotoTexture {
+    cv::Mat texture;    // BGR, size x size, in the mesh's UV layout
+    double seenFraction = 0.0;  // share of the head's texels some photo saw (the rest was filled in)
+    // Where each texel's colour came from: 0 filled in (no photo saw it, or no triangle covers it), 1 the front
+    // photo, 2 the side photo (either side of the head; mirrored for the side it did not see).
+    cv::Mat source;     // CV_8U, size x size
+    enum Source : unsigned char { Filled = 0, Front = 1, Side = 2 };
+};
+
+// front/side: the photos as taken; the masks: their silhouettes. A texel takes a photo's colour only where that
+// photo sees the surface point: facing the camera, inside the silhouette, and not hidden by another part of the
+// head (a z-buffer of the fitted mesh rendered from that photo's orthographic view). The side photo is used for
+// both sides of the head. Texels no photo saw (the back of the head) are filled from their surroundings by a
+// pull-push (coarse-to-fine) fill, so they continue the hair and skin colours around them.
+PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
+                               const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options = {});
+
+// Computes what textureFromPhotos needs once per UV layout and size (which texel lies in which triangle) ahead of
+// time, so that the first visitor's texture does not pay for it. Meshes of the same topology and UVs share it.
+void prepareTexture(const Mesh& mesh, const PhotoTextureOptions& options = {});
+
+// Fills texels where weight == 0 from the others, coarse to fine (pull-push); texels of partial weight blend
+// with the fill. colour: CV_32FC3, weight: CV_32F (all 1 afterwards).
+void pullPushFill(cv::Mat& colour, cv::Mat& weight);
+
+}  // namespace avatarbooth

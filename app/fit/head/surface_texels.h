@@ -1,0 +1,39 @@
+// The mesh surface seen from texture space: for every texel, the 3-D point and normal it stands for.
+// Texturing (photo projection) and the synthetic visitor's face paint both work texel by texel through this.
+#pragma once
+
+#include "fit/head/mesh.h"
+
+#include <opencv2/core.hpp>
+
+namespace avatarbooth {
+
+struct SurfaceTexels {
+    cv::Mat position;  // CV_32FC3, head-space millimetres at the texel centre
+    cv::Mat normal;    // CV_32FC3, unit normal (interpolated vertex normals)
+    cv::Mat covered;   // CV_8U, 255 where a triangle covers the texel centre
+};
+
+// Which triangle covers each texel centre, and where in it: depends only on the UVs, so it is computed once per
+// base head and reused for every fitted head of that topology.
+struct TexelMap {
+    cv::Size size;
+    cv::Mat triangle;     // CV_32S, index into Mesh::triangles, -1 where no triangle covers the texel
+    cv::Mat barycentric;  // CV_32FC2, weights of the triangle's first two corners (the third is 1 - both)
+};
+
+TexelMap mapTexels(const Mesh& mesh, cv::Size size);
+// The map of mesh's UV layout at this size from a process-wide cache (thread-safe).
+const TexelMap& cachedTexelMap(const Mesh& mesh, cv::Size size);
+// Positions and normals of the mesh at every mapped texel.
+SurfaceTexels sampleSurfaceTexels(const Mesh& mesh, const std::vector<glm::dvec3>& normals, const TexelMap& map);
+
+// Rasterises every triangle in UV space (texel centres at +0.5; the glTF convention, v down) and interpolates
+// positions and the given per-vertex normals barycentrically.
+SurfaceTexels sampleSurfaceTexels(const Mesh& mesh, const std::vector<glm::dvec3>& normals, cv::Size size);
+
+// Extends the colours of covered texels a few texels into the uncovered ones, so that mipmapping and bilinear
+// filtering never pull in the empty background along UV borders.
+void padTextureBorders(cv::Mat& textureBgr, const cv::Mat& covered, int texels = 4);
+
+}  // namespace avatarbooth

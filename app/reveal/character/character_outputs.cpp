@@ -1,0 +1,57 @@
+// character.json and character.glb from a fit's front-photo analysis.
+#include "reveal/character/character_outputs.h"
+
+#include "fit/export/glb.h"
+
+namespace avatarbooth {
+
+std::optional<cv::Point2d> earHoleInFrontPhoto(const HeadFit& fit, const std::map<std::string, cv::Point2d>& side) {
+    const auto it = side.find("ear_hole");
+    if (it == side.end()) return std::nullopt;
+    const glm::dvec2 zy = fit.side.toHead(it->second);
+    return fit.front.toPixel(glm::dvec2(0.0, zy.y));
+}
+
+CharacterOutputs makeCharacterOutputs(const cv::Mat& frontPhoto, const std::array<cv::Point2d, 68>& landmarks,
+                                      const cv::Mat& frontMask, std::optional<cv::Point2d> earHole,
+                                      const BaseHead& base, const CharacterSettings& settings) {
+    NaritaMappingInput input;
+    input.landmarks = landmarks;
+    input.mask = frontMask;
+    input.earHole = earHole;
+    const NaritaMapping mapping = mapNaritaPoints(input);
+    const CharacterProportions proportions = computeProportions(mapping.points);
+    const CharacterLook look = settings.coloursFromPhoto ? lookFromPhoto(frontPhoto, landmarks, frontMask) : CharacterLook{};
+    CharacterHead head = makeCharacterHead(base, proportions, settings, look);
+
+    nlohmann::json j = characterJson(mapping, proportions);
+    nlohmann::json character;
+    character["file"] = "character.glb";
+    character["exaggeration"] = settings.exaggeration;
+    character["colours"] = settings.coloursFromPhoto ? "photo" : "fixed";
+    nlohmann::json applied = nlohmann::json::array();
+    for (const SliderRange& s : sliderRanges())
+        if (!settings.sliders || settings.sliders->count(std::string(s.key))) applied.push_back(s.key);
+    character["sliders_applied"] = applied;
+    for (const auto& [name, value] : std::map<std::string, const CharacterProportions*>{
+             {"target", &head.target}, {"achieved", &head.achieved}, {"base_head", &head.base}}) {
+        nlohmann::json ratios;
+        for (std::size_t i = 0; i < value->r.size(); ++i) ratios["r" + std::to_string(i)] = value->r[i];
+        ratios["eye_spacing"] = value->eyeSpacing;
+        ratios["eye_tilt_deg"] = value->eyeTiltDeg;
+        ratios["brow_tilt_deg"] = value->browTiltDeg;
+        character[name] = ratios;
+    }
+    character["note"] = "target: the measured proportions clamped to the slider ranges; achieved: what the character "
+                        "head measures (front silhouette and feature vertices, the same mapping as the photo)";
+    j["character_head"] = character;
+
+    CharacterOutputs out;
+    out.json = j.dump(2) + "\n";
+    out.glb = encodeGlb(head.mesh, head.texture, "character");
+    out.warnings = mapping.warnings;
+    out.head = std::move(head);
+    return out;
+}
+
+}  // namespace avatarbooth
