@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# The README's main command: set up (packages, build), then run the kiosk on the simulated booth for one whole
-# visitor session (headless), and say where the screenshots of every screen and the avatar are.
+# The README's main command: set up (packages, then the avatarbooth executable alone: no tests, no benchmarks), run
+# the kiosk on the simulated booth for one whole visitor session (headless), and say where the screenshots of every
+# screen and the avatar are.
 # Usage: sim/demo.sh [OUTPUT_FOLDER]   (default: ./out/demo)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:-$root/out/demo}"
-"$root/tests/setup.sh" release
+"$root/tests/setup.sh" release avatarbooth
 bin="$root/build/release/app/avatarbooth"
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"

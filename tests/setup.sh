@@ -2,10 +2,14 @@
 # Set-up shared by the README's two commands: installs the Debian packages that are missing (as root, with
 # apt-get), installs from npm the glTF validator (tests/gltf/), the batch report's 3-D viewer (app/assets/report/)
 # and the browser driver of the report test (tests/browser/), and builds the project with CMake.
-# Usage: tests/setup.sh [PRESET]   (default: release; CI uses "ci", which turns warnings into errors)
+# Usage: tests/setup.sh [PRESET] [TARGET...]   (default: release; CI uses "ci", which turns warnings into errors)
+# With TARGETs (sim/demo.sh passes avatarbooth) only those are built and the npm packages of the tests are left out;
+# without, everything is built (the tests, the benchmarks).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 preset="${1:-release}"
+shift || true
+targets=("$@")
 
 packages=(
   build-essential cmake pkg-config git
@@ -47,6 +51,13 @@ if ((${#missing[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   apt-get update -qq
   apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+if ((${#targets[@]})); then
+  echo "setup: building ${targets[*]} ($preset)"
+  cmake --preset "$preset" -S "$root" >/dev/null
+  cmake --build --preset "$preset" -j "$(nproc)" --target "${targets[@]}"
+  exit 0
 fi
 
 if [ ! -d "$root/tests/gltf/node_modules/gltf-validator" ]; then
