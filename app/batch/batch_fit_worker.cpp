@@ -1,16 +1,17 @@
 // One batch worker: the fit pipeline (sharing the loaded landmark model) and an offscreen renderer of its own.
 #include "batch/batch_fit_worker.h"
 
+#include "booth/session_folder.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/file_bytes.h"
 #include "common/image_io.h"
 #include "render/mesh_renderer.h"
+#include "reveal/character/character_outputs.h"
 
 #include <opencv2/imgproc.hpp>
 
 #include <chrono>
-#include <fstream>
-#include <sstream>
 
 namespace avatarbooth {
 namespace fs = std::filesystem;
@@ -18,14 +19,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::string readBytes(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BoothError(ErrorKind::BadInput, path.string(), "cannot read");
-    std::ostringstream buffer;
-    buffer << in.rdbuf();
-    return buffer.str();
-}
 
 std::string base64(const std::string& bytes) {
     static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -92,8 +85,9 @@ SessionRecord startRecord(const BatchItem& item) {
 
 class FitWorker final : public BatchWorker {
 public:
-    FitWorker(const FitPipeline& shared, fs::path out)
-        : pipeline_(shared.forAnotherThread()), renderer_(std::make_unique<MeshRenderer>()), out_(std::move(out)) {}
+    FitWorker(const FitPipeline& shared, BatchFolderSettings folders, fs::path out)
+        : pipeline_(shared.forAnotherThread()), renderer_(std::make_unique<MeshRenderer>()),
+          folders_(std::move(folders)), out_(std::move(out)) {}
 
     SessionRecord process(const BatchItem& item, const std::atomic<bool>& stop) override {
         SessionRecord r = startRecord(item);
@@ -122,16 +116,18 @@ public:
         }
         const double readSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
         try {
-            const FitInputs inputs{item.front, item.side, item.background};
-            // The pipeline tells each stage as it starts: the place to give up when asked to stop.
-            const StageListener listener = [&stop](const std::string&) {
-                if (stop.load()) throw BatchInterrupted();
-            };
-            FitOutcome outcome = pipeline_->fit(front, side, background, inputs, listener);
-            outcome.stageSeconds.insert(outcome.stageSeconds.begin(), {"read_photos", readSeconds});
+            const FitPhotoFiles files{item.front, item.side, item.background};
+            // The pipeline gives up between two steps once asked to stop.
+            FitOutcome outcome = pipeline_->fit(front, side, background, FitPhotoNames::of(files), {{}, CancelToken(stop)});
+            outcome.stageSeconds.insert(outcome.stageSeconds.begin(), {toString(FitStep::ReadPhotos), readSeconds});
+            std::optional<CharacterOutputs> character;
+            if (folders_.character) character = makeCharacterOutputs(outcome, pipeline_->baseHead(), *folders_.character);
             if (stop.load()) throw BatchInterrupted();
             // Written under a temporary name and renamed when complete (fit.json last): complete or absent.
-            pipeline_->write(outcome, inputs, sessionFolder(out_, item.id), *renderer_);
+            writeSessionFolder(outcome, {files, character ? &*character : nullptr, folders_.previewSize},
+                               sessionFolder(out_, item.id), *renderer_);
+        } catch (const FitCancelled&) {
+            throw BatchInterrupted();
         } catch (const BoothError& e) {
             return fail(failureReason(e.kind()), e.what());
         } catch (const cv::Exception& e) {
@@ -164,6 +160,7 @@ public:
 private:
     std::unique_ptr<FitPipeline> pipeline_;
     std::unique_ptr<MeshRenderer> renderer_;  // its own headless EGL context, current on this worker's thread
+    BatchFolderSettings folders_;
     fs::path out_;
 };
 
@@ -195,7 +192,7 @@ std::map<std::string, std::string> writeReportFiles(const fs::path& out, const s
         if (path.empty()) continue;
         files[name] = putThumbnail(out, id, name, readPhoto(path));
     }
-    const std::string glb = readBytes(session / "avatar.glb");
+    const std::string glb = readFileBytes(session / "avatar.glb");
     // A script, not a fetch: Chromium refuses fetch() on file:// pages, but loads <script src> from beside the page.
     const std::string script = "avatarboothGlb(" + nlohmann::json(id).dump() + ", \"" + base64(glb) + "\");\n";
     writeFileAtomically(reportFilesFolder(out, id) / "avatar.glb.js", script);
@@ -208,7 +205,7 @@ SessionRecord recordFromSessionFolder(const fs::path& out, const BatchItem& item
     const fs::path fitJson = sessionFolder(out, item.id) / "fit.json";
     nlohmann::json fit;
     try {
-        fit = nlohmann::json::parse(readBytes(fitJson));
+        fit = nlohmann::json::parse(readFileBytes(fitJson));
     } catch (const nlohmann::json::exception& e) {
         throw BoothError(ErrorKind::BadInput, fitJson.string(), std::string("not valid JSON: ") + e.what());
     }
@@ -229,8 +226,8 @@ SessionRecord recordFromSessionFolder(const fs::path& out, const BatchItem& item
     return r;
 }
 
-std::unique_ptr<BatchWorker> makeFitWorker(const FitPipeline& shared, const fs::path& out) {
-    return std::make_unique<FitWorker>(shared, out);
+std::unique_ptr<BatchWorker> makeFitWorker(const FitPipeline& shared, BatchFolderSettings folders, const fs::path& out) {
+    return std::make_unique<FitWorker>(shared, std::move(folders), out);
 }
 
 }  // namespace avatarbooth

@@ -5,17 +5,26 @@
 #include "batch/batch_runner.h"
 #include "common/error.h"
 #include "fit/fit_pipeline.h"
+#include "reveal/character/character_head.h"
 
 #include <memory>
+#include <optional>
 
 namespace avatarbooth {
 
 // Longest side of the report's thumbnails, in pixels.
 inline constexpr int kReportThumbnailSize = 320;
 
+// What each session folder gets besides the fit: the character (when its settings are given) and the previews' size.
+struct BatchFolderSettings {
+    std::optional<CharacterSettings> character;
+    int previewSize = 512;
+};
+
 // A worker for `runBatch`: make it on the worker thread. It shares `shared`'s loaded landmark model (and base head)
 // and has its own face detector and offscreen renderer. `shared` must outlive the worker.
-std::unique_ptr<BatchWorker> makeFitWorker(const FitPipeline& shared, const std::filesystem::path& out);
+std::unique_ptr<BatchWorker> makeFitWorker(const FitPipeline& shared, BatchFolderSettings folders,
+                                           const std::filesystem::path& out);
 
 // The failure reason of an error, as summary.json names it.
 std::string failureReason(ErrorKind kind);

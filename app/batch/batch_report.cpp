@@ -3,11 +3,11 @@
 
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/file_bytes.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -15,14 +15,6 @@ namespace avatarbooth {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string readText(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BoothError(ErrorKind::BadInput, path.string(), "cannot read");
-    std::ostringstream buffer;
-    buffer << in.rdbuf();
-    return buffer.str();
-}
 
 std::string html(const std::string& text) {
     std::string out;
@@ -314,10 +306,10 @@ void writeSummaryAndReport(const fs::path& out, const nlohmann::json& summary, c
     if (ec) throw BoothError(ErrorKind::Output, out.string(), "cannot create folder: " + ec.message());
     if (!modelViewerJs.empty()) {
         fs::create_directories(out / "model-viewer", ec);
-        writeFileAtomically(out / "model-viewer" / kViewerFile, readText(modelViewerJs));
+        writeFileAtomically(out / "model-viewer" / kViewerFile, readFileBytes(modelViewerJs));
         // model-viewer is Apache-2.0 (bundling three.js, MIT): its licence travels with the copy.
         const fs::path licence = modelViewerJs.parent_path().parent_path() / "LICENSE";
-        if (fs::is_regular_file(licence, ec)) writeFileAtomically(out / "model-viewer" / "LICENSE", readText(licence));
+        if (fs::is_regular_file(licence, ec)) writeFileAtomically(out / "model-viewer" / "LICENSE", readFileBytes(licence));
     }
     writeFileAtomically(out / "summary.json", summary.dump(2) + "\n");
     writeFileAtomically(out / "report.html", renderHtml(summary, !modelViewerJs.empty()));
@@ -335,7 +327,7 @@ nlohmann::json mergeSummaries(const std::vector<fs::path>& parts, const fs::path
         const fs::path file = part / "summary.json";
         nlohmann::json summary;
         try {
-            summary = nlohmann::json::parse(readText(file));
+            summary = nlohmann::json::parse(readFileBytes(file));
         } catch (const nlohmann::json::exception& e) {
             throw BoothError(ErrorKind::BadInput, file.string(), std::string("not valid JSON: ") + e.what());
         }

@@ -2,6 +2,8 @@
 // back, and the model of the screen to show. Plain values, so the flow, the screens and the kiosk share no code.
 #pragma once
 
+#include "fit/fit_step.h"
+
 #include <chrono>
 #include <cstdint>
 #include <optional>
@@ -80,9 +82,9 @@ struct CaptureFailed {
     std::string detail;
     FlowTime t;
 };
+// The fit has started a step (its share of the progress bar is fit_step.h's).
 struct FitProgress {
-    double fraction;   // 0..1
-    std::string stage; // the pipeline's stage name ("front_landmarks", "texture", ...)
+    FitStep step;
     FlowTime t;
 };
 struct FitDone {
@@ -203,7 +205,7 @@ struct ScreenModel {
     Hint hint = Hint::None;          // guides
     int countdown = 0;               // countdown: the number shown (3, 2, 1)
     double progress = 0.0;           // processing: 0..1
-    std::string stage;               // processing: the pipeline's stage name
+    std::optional<FitStep> fitStep;  // processing: the step the fit is in (none before the first)
     std::string code;                // thanks: the session's short code (empty while saving)
     BannerKind banner = BannerKind::None;
     FitFailure fitFailure = FitFailure::Other;  // with BannerKind::FitFailed

@@ -151,8 +151,8 @@ std::vector<FlowCommand> VisitorFlow::handle(const FlowEvent& event) {
                    },
                    [&](const FitProgress& e) {
                        if (state_ != State::Processing) return;
-                       screen_.progress = std::clamp(e.fraction, 0.0, 1.0);
-                       screen_.stage = e.stage;
+                       screen_.progress = progressAtStart(e.step);
+                       screen_.fitStep = e.step;
                    },
                    [&](const FitDone& e) {
                        if (state_ != State::Processing) return;
@@ -368,7 +368,7 @@ void VisitorFlow::startSession(FlowTime t, std::vector<FlowCommand>& out) {
     banner_ = BannerKind::None;
     screen_.code.clear();
     screen_.progress = 0.0;
-    screen_.stage.clear();
+    screen_.fitStep.reset();
     toGuide(Photo::Front, t, out);
 }
 
@@ -390,7 +390,7 @@ void VisitorFlow::nextAfterCapture(FlowTime t, std::vector<FlowCommand>& out) {
     } else {
         setPreview(false, photo_, out);
         screen_.progress = 0.0;
-        screen_.stage.clear();
+        screen_.fitStep.reset();
         enter(State::Processing, t, out);
         out.push_back(StartFit{});
         fitRunning_ = true;

@@ -179,8 +179,11 @@ void registerBatchCommand(CLI::App& app) {
             items = selectShard(items, shard);
         }
 
-        FitSettings settings;
-        if (!o->config.empty()) settings = loadBoothConfig(o->config).fit.settings;
+        BoothConfig config;
+        if (!o->config.empty()) config = loadBoothConfig(o->config);
+        FitSettings settings = config.fit.settings;
+        BatchFolderSettings folders{std::nullopt, config.fit.previewSize};
+        if (config.character.enabled) folders.character = config.character.settings;
         if (cmd->count("--landmark-model") > 0 || o->config.empty()) settings.landmarkModel = o->model;
         // The landmark model is loaded once here; each worker shares it (see FitPipeline::forAnotherThread).
         const FitPipeline pipeline(settings);
@@ -199,7 +202,7 @@ void registerBatchCommand(CLI::App& app) {
         std::cout << " on " << std::min<std::size_t>(static_cast<std::size_t>(o->jobs), std::max<std::size_t>(1, items.size()))
                   << " workers; landmark model loaded in " << static_cast<int>(pipeline.modelLoadSeconds() * 1000.0) << " ms\n"
                   << std::flush;
-        const BatchRunResult result = runBatch(items, options, [&] { return makeFitWorker(pipeline, out); });
+        const BatchRunResult result = runBatch(items, options, [&] { return makeFitWorker(pipeline, folders, out); });
         signal(SIGINT, SIG_DFL);
         signal(SIGTERM, SIG_DFL);
         if (result.interrupted) printer.interrupted();

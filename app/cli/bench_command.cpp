@@ -35,7 +35,7 @@ std::string loadAverage() {
 void registerBenchCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand("bench", "Time each stage of the fit on one photo pair (medians over runs)");
     struct Options {
-        FitInputs inputs;
+        FitPhotoFiles inputs;
         int runs = 5;
     };
     auto o = std::make_shared<Options>();
@@ -51,7 +51,7 @@ void registerBenchCommand(CLI::App& app) {
         std::vector<std::string> order;
         RecentTimings totals, cpuTotals;
         for (int i = 0; i < o->runs; ++i) {
-            const FitOutcome out = pipeline.fit(front, side, background, o->inputs);
+            const FitOutcome out = pipeline.fit(front, side, background, FitPhotoNames::of(o->inputs));
             if (i == 0) {
                 for (const auto& [name, s] : out.stageSeconds) order.push_back(name);
                 continue;  // warm-up: caches, lazy initialisation

@@ -1,18 +1,22 @@
 // `avatarbooth fit --front F --side S [--background B] -o OUT/`: one photo pair to a session folder.
 #include "cli/commands.h"
 
+#include "booth/session_folder.h"
 #include "common/error.h"
 #include "config/booth_config.h"
 #include "fit/fit_pipeline.h"
+#include "render/mesh_renderer.h"
+#include "reveal/character/character_outputs.h"
 
 #include <iostream>
+#include <optional>
 
 namespace avatarbooth {
 
 void registerFitCommand(CLI::App& app) {
     auto* cmd = app.add_subcommand("fit", "Fit a textured 3-D head to a front and a side photo");
     struct Options {
-        FitInputs inputs;
+        FitPhotoFiles inputs;
         std::string out;
         std::string kernel = "ntt";
         double unitMm = 23.0;
@@ -35,9 +39,10 @@ void registerFitCommand(CLI::App& app) {
     cmd->add_option("--texture-size", o->textureSize, "Texture size in texels")->capture_default_str()->check(CLI::Range(256, 4096));
     cmd->add_option("--config", o->config, "Booth configuration: its [fit] table gives the defaults of the options above");
     cmd->callback([o, cmd] {
-        // The config's [fit] table first; each option given on the command line then wins over it.
-        FitConfig fromFile;
-        if (!o->config.empty()) fromFile = loadBoothConfig(o->config).fit;
+        // The config's [fit] and [character] tables first; each option given on the command line then wins over it.
+        BoothConfig config;
+        if (!o->config.empty()) config = loadBoothConfig(o->config);
+        const FitConfig& fromFile = config.fit;
         FitSettings settings = fromFile.settings;
         const auto given = [&](const char* option) { return cmd->count(option) > 0; };
         if (given("--kernel")) {
@@ -61,10 +66,14 @@ void registerFitCommand(CLI::App& app) {
             throw BoothError(ErrorKind::BadConfig, "--base-mesh/--base-features", "give both or neither");
         std::unique_ptr<BaseHead> custom;
         if (!o->baseMesh.empty()) custom = std::make_unique<BaseHead>(loadBaseHead(o->baseMesh, o->baseFeatures));
-        const FitPipeline pipeline(settings, custom ? *custom : builtinBaseHead());
+        const BaseHead& base = custom ? *custom : builtinBaseHead();
+        const FitPipeline pipeline(settings, base);
         const FitOutcome outcome = pipeline.fit(o->inputs);
+        std::optional<CharacterOutputs> character;
+        if (config.character.enabled) character = makeCharacterOutputs(outcome, base, config.character.settings);
         MeshRenderer renderer;
-        const auto written = pipeline.write(outcome, o->inputs, o->out, renderer);
+        writeSessionFolder(outcome, {o->inputs, character ? &*character : nullptr, fromFile.previewSize}, o->out,
+                           renderer);
         for (const auto& w : outcome.warnings) std::cerr << "avatarbooth: warning: " << w << "\n";
         double seconds = 0.0;
         for (const auto& [name, s] : outcome.stageSeconds) seconds += s;

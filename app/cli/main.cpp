@@ -1,4 +1,4 @@
-// The avatarbooth executable: one binary, one subcommand per job (fit now; run, batch, check later).
+// The avatarbooth executable: one binary, one subcommand per job (run, fit, batch, check, config, ...: cli/*.cpp).
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
 

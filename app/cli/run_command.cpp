@@ -27,18 +27,6 @@ namespace fs = std::filesystem;
 std::atomic<bool> stopRequested{false};
 extern "C" void onStopSignal(int) { stopRequested.store(true); }
 
-// Ends the process while the kiosk's model-loading thread is still running (stopped during start-up): the output
-// flushed, then std::quick_exit, which runs no static destructors -- the load still reads the built-in base head and
-// the texture's static caches, which exit() would destroy under it. Nothing else needs tearing down: the kiosk has
-// already closed the devices and discarded an unfinished session.
-[[noreturn]] void endLeavingTheModelLoad(int code) {
-    spdlog::default_logger()->flush();
-    std::cout.flush();
-    std::cerr.flush();
-    std::fflush(nullptr);
-    std::quick_exit(code);
-}
-
 constexpr const char* kInstalledConfig = "/etc/avatarbooth/booth.toml";
 
 // Whether this process may create and write the folder (or its nearest existing parent).
@@ -126,15 +114,7 @@ void registerRunCommand(CLI::App& app) {
         options.screenshots = o->screenshots;
         options.visitor = visitor ? &simVisitor : nullptr;
         options.stop = &stopRequested;
-        KioskReport report;
-        try {
-            report = runKiosk(config, options);
-        } catch (const std::exception& e) {
-            if (!kioskLeftAThreadRunning()) throw;
-            const auto* booth = dynamic_cast<const BoothError*>(&e);
-            std::cerr << "avatarbooth: " << (booth ? "error: " : "internal error: ") << e.what() << "\n";
-            endLeavingTheModelLoad(booth ? exitCodeFor(booth->kind()) : kExitInternal);
-        }
+        const KioskReport report = runKiosk(config, options);
 
         std::cout << report.sessionsEnded << " visitor session(s); kept:";
         for (const auto& code : report.keptCodes) std::cout << " " << code;
@@ -158,7 +138,6 @@ void registerRunCommand(CLI::App& app) {
                     report.characterFrameMilliseconds, report.characterRenders, report.toonFrameMilliseconds,
                     report.toonRenders, report.stageRenderMilliseconds, report.stageRenders, report.styleFrames,
                     report.toonBuildSeconds);
-        if (kioskLeftAThreadRunning()) endLeavingTheModelLoad(kExitOk);
         if (report.revealFrameMilliseconds > 0.0)
             std::printf("reveal frame parts: avatar render %.1f ms (%zu triangles, %d samples, %.0f%% of the frames "
                         "render a new pose, the others show the pose held from before), screen %.1f ms, present "

@@ -20,15 +20,19 @@ enum class ErrorKind {
 class BoothError : public std::runtime_error {
 public:
     BoothError(ErrorKind kind, std::string where, const std::string& what)
-        : std::runtime_error(where.empty() ? what : where + ": " + what), kind_(kind), where_(std::move(where)) {}
+        : std::runtime_error(where.empty() ? what : where + ": " + what), kind_(kind), where_(std::move(where)),
+          message_(what) {}
 
     ErrorKind kind() const { return kind_; }
     // The file (and line/field where known) the error is about; empty when it concerns no file.
     const std::string& where() const { return where_; }
+    // What went wrong, without the where (what() is "where: message").
+    const std::string& message() const { return message_; }
 
 private:
     ErrorKind kind_;
     std::string where_;
+    std::string message_;
 };
 
 }  // namespace avatarbooth

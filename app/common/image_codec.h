@@ -2,7 +2,7 @@
 // here (image_codec.cpp says why).
 //
 // Why not OpenCV's imgcodecs: Debian builds it against GDAL, so linking it loads about a hundred more libraries
-// (GDAL, PROJ, Poppler, HDF5, ...) that hold 37 MB resident in the kiosk for formats a booth never reads. The
+// (GDAL, PROJ, Poppler, HDF5, ...) resident in the kiosk for formats a booth never reads (README, "Memory"). The
 // decoders here are the ones imgcodecs uses for JPEG and PNG, set up the same way (8-bit BGR, EXIF orientation
 // applied to JPEGs), so the pixels are the same to the bit.
 #pragma once

@@ -2,13 +2,12 @@
 #include "common/image_io.h"
 
 #include "common/error.h"
+#include "common/file_bytes.h"
 #include "common/image_codec.h"
 #include "common/image_header.h"
 
-#include <fstream>
-#include <iterator>
+#include <span>
 #include <string>
-#include <vector>
 
 namespace avatarbooth {
 namespace fs = std::filesystem;
@@ -32,13 +31,9 @@ std::string encodeImage(const cv::Mat& image, const std::string& ext, int jpegQu
 }
 
 cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) bad(path, "file not found");
-    if (!fs::is_regular_file(path, ec)) bad(path, "is not a regular file (a folder with an image's name?)");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) bad(path, "cannot be opened (permissions?)");
-    const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (bytes.empty()) bad(path, "is empty (0 bytes)");
+    const std::string file = readFileBytes(path);
+    if (file.empty()) bad(path, "is empty (0 bytes)");
+    const std::span<const unsigned char> bytes(reinterpret_cast<const unsigned char*>(file.data()), file.size());
 
     // The declared size is checked before decoding: a small file declaring a huge image (any format) is refused
     // here instead of making the decoder allocate gigabytes.

@@ -235,7 +235,7 @@ BoothConfig parseBoothConfig(const std::string& text, const std::string& name) {
     readTable(top, "", nullptr, config, 0);
     // [reveal] styles and [character] enabled: a style listed that no fit would make would silently never show;
     // not listed at all, the default list drops what is switched off.
-    if (!config.fit.settings.characterEnabled && config.reveal.shows(AvatarStyle::Character)) {
+    if (!config.character.enabled && config.reveal.shows(AvatarStyle::Character)) {
         if (const toml::node* styles = root.at_path("reveal.styles").node())
             throw BoothError(ErrorKind::BadConfig, name + ":" + std::to_string(styles->source().begin.line),
                              "reveal.styles: \"character\" is listed but [character] enabled = false (remove it "
@@ -270,7 +270,7 @@ BoothConfig loadBoothConfig(const std::filesystem::path& file) {
 }
 
 std::shared_ptr<const BaseHead> configuredBaseHead(const FitConfig& fit) {
-    if (fit.baseMesh.empty()) return std::shared_ptr<const BaseHead>(&builtinBaseHead(), [](const BaseHead*) {});
+    if (fit.baseMesh.empty()) return sharedBuiltinBaseHead();
     return std::make_shared<const BaseHead>(loadBaseHead(fit.baseMesh, fit.baseFeatures));
 }
 

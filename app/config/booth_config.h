@@ -15,6 +15,7 @@
 #include "drivers/display/display_settings.h"
 #include "drivers/gpio/gpio_settings.h"
 #include "fit/head/base_head.h"
+#include "reveal/character/character_head.h"
 #include "reveal/styles/style_settings.h"
 #include "fit/fit_pipeline.h"
 #include "booth/screens/screens.h"
@@ -30,6 +31,14 @@ struct FitConfig {
     FitSettings settings;
     std::filesystem::path baseMesh;      // your own base head (glb with UVs), see `avatarbooth make-base-head`
     std::filesystem::path baseFeatures;  // its feature file
+    int previewSize = 512;               // the session folder's preview PNGs, in pixels
+};
+
+// [character]: the character avatar (Narita), made from every fit when enabled: character.json + character.glb in
+// the session, and the character style on the reveal.
+struct CharacterConfig {
+    bool enabled = true;
+    CharacterSettings settings;
 };
 
 struct BoothConfig {
@@ -43,7 +52,7 @@ struct BoothConfig {
     GuidanceSettings guidance;   // [guidance]
     SessionStoreSettings sessions;  // [sessions]
     AnimationSettings animation;    // [animation]
-    // [character] fills fit.settings.characterEnabled and fit.settings.character.
+    CharacterConfig character;      // [character]
     RevealSettings reveal;          // [reveal]
     StageSettings stage;            // [stage]
 };

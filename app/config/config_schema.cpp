@@ -151,14 +151,14 @@ ConfigKey characterSliders() {
     return words(
         "character", "sliders", sliderKeys(), 0,
         [](const BoothConfig& c) {
-            const auto& chosen = c.fit.settings.character.sliders;
+            const auto& chosen = c.character.settings.sliders;
             std::vector<std::string> out;
             for (const std::string& key : sliderKeys())
                 if (!chosen || chosen->count(key)) out.push_back(key);
             return out;
         },
         [](BoothConfig& c, const std::vector<std::string>& v) {
-            auto& sliders = c.fit.settings.character.sliders;
+            auto& sliders = c.character.settings.sliders;
             sliders = std::set<std::string>(v.begin(), v.end());
             if (sliders->size() == sliderRanges().size()) sliders.reset();  // all of them: the default
         },
@@ -299,7 +299,7 @@ std::vector<ConfigTable> makeTables() {
                  }});
     t.push_back({.name = "animation", .doc = "The avatar's turn on the reveal and attract screens."});
     t.push_back({.name = "character",
-                 .doc = "The character avatar (issue 6): a stylised head made from the base head, its face parts moved "
+                 .doc = "The character avatar: a stylised head made from the base head, its face parts moved "
                         "and scaled to the visitor's proportions (Narita); written as character.json + character.glb "
                         "in every session when enabled."});
     t.push_back({.name = "reveal", .doc = "The avatar styles on the reveal and attract screens."});
@@ -327,7 +327,7 @@ std::vector<ConfigKey> makeKeys() {
                        "The RBF's distance r is measured in units of this many millimetres."));
     k.push_back(integer("fit", "texture_size", FIELD(fit.settings.texture.size), 256, 4096,
                         "The avatar's texture, texels per side."));
-    k.push_back(integer("fit", "preview_size", FIELD(fit.settings.previewSize), 64, 4096,
+    k.push_back(integer("fit", "preview_size", FIELD(fit.previewSize), 64, 4096,
                         "The preview renders of a session, pixels per side."));
     // [camera]
     k.push_back(choice("camera", "backend", FIELD(camera.backend), {"auto", "v4l2", "libcamera", "sim"},
@@ -488,18 +488,18 @@ std::vector<ConfigKey> makeKeys() {
     k.push_back(number("animation", "hold_fraction", FIELD(animation.holdFraction), 0.0, 0.9,
                        "N_hf: the share of the frames held."));
     // [character]
-    k.push_back(flag("character", "enabled", FIELD(fit.settings.characterEnabled),
+    k.push_back(flag("character", "enabled", FIELD(character.enabled),
                      "Make the character in every fit (character.json + character.glb in the session)."));
-    k.push_back(number("character", "exaggeration", FIELD(fit.settings.character.exaggeration), 0.0, 3.0,
+    k.push_back(number("character", "exaggeration", FIELD(character.settings.exaggeration), 0.0, 3.0,
                        "1: the measured proportions; above 1 exaggerates each away from the base head's (caricature), "
                        "below 1 tones down."));
     k.push_back(characterSliders());
     k.push_back(enumChoice(
-        "character", "colours", FIELD(fit.settings.character.coloursFromPhoto), {"photo", "fixed"},
+        "character", "colours", FIELD(character.settings.coloursFromPhoto), {"photo", "fixed"},
         [](bool fromPhoto) { return fromPhoto ? "photo" : "fixed"; },
         [](const std::string& s) { return s == "photo"; },
         "\"photo\": skin and hair colours sampled from the front photo; \"fixed\": the built-in palette."));
-    k.push_back(integer("character", "texture_size", FIELD(fit.settings.character.textureSize), 64, 4096,
+    k.push_back(integer("character", "texture_size", FIELD(character.settings.textureSize), 64, 4096,
                         "Edge of the painted (flat-colour) texture in texels."));
     // [reveal]
     k.push_back(revealStyles());

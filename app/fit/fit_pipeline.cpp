@@ -1,20 +1,15 @@
-// The photo-to-head pipeline: stages, timings, error attribution, the session folder.
+// The photo-to-head pipeline: steps, timings, which photo an error is about, cancellation between steps.
 #include "fit/fit_pipeline.h"
 
-#include "reveal/character/character_outputs.h"
-#include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/image_io.h"
-#include "fit/export/glb.h"
 #include "fit/face/profile.h"
 #include "fit/face/silhouette.h"
-#include "render/previews.h"
 
 #include <opencv2/imgproc.hpp>
 
 #include <chrono>
 #include <ctime>
-#include <fstream>
 
 namespace avatarbooth {
 namespace fs = std::filesystem;
@@ -32,15 +27,32 @@ double processCpuSeconds() {
     return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-// Runs one stage, timing it, and names the photo in any error that does not name a file yet.
+// The photo each step looks at, for the error that says which to take again (the head fit and the texture use both).
+FitPhoto photoOf(FitStep step) {
+    switch (step) {
+        case FitStep::FrontLandmarks:
+        case FitStep::FrontSilhouette: return FitPhoto::Front;
+        case FitStep::SideProfile: return FitPhoto::Side;
+        default: return FitPhoto::Both;
+    }
+}
+
+const std::string& nameOf(FitPhoto photo, const FitPhotoNames& names) {
+    static const std::string none;
+    return photo == FitPhoto::Front ? names.front : photo == FitPhoto::Side ? names.side : none;
+}
+
+// Runs one step, timing it: stops first when asked to, tells the listener, and turns any error into a FitError
+// about the step's photo (or the photo the error itself names), with that photo's name where the error has none.
 template <typename Out, typename F>
-auto stage(Out& out, const StageListener& listener, const char* name, const fs::path& photo, F&& work) {
-    if (listener) listener(name);
+auto runStep(Out& out, const FitControl& control, FitStep step, const FitPhotoNames& names, F&& work) {
+    if (control.cancel.cancelled()) throw FitCancelled();
+    if (control.listener) control.listener(step);
     const auto t0 = Clock::now();
     const double cpu0 = processCpuSeconds();
     const auto record = [&] {
-        out.stageSeconds.emplace_back(name, secondsSince(t0));
-        out.stageCpuSeconds.emplace_back(name, processCpuSeconds() - cpu0);
+        out.stageSeconds.emplace_back(toString(step), secondsSince(t0));
+        out.stageCpuSeconds.emplace_back(toString(step), processCpuSeconds() - cpu0);
     };
     try {
         if constexpr (std::is_void_v<decltype(work())>) {
@@ -51,24 +63,14 @@ auto stage(Out& out, const StageListener& listener, const char* name, const fs::
             record();
             return result;
         }
+    } catch (const FitError& e) {
+        throw FitError(e, nameOf(e.photo(), names));
     } catch (const BoothError& e) {
-        if (!e.where().empty() || photo.empty()) throw;
-        throw BoothError(e.kind(), photo.string(), e.what());
+        throw FitError(e, photoOf(step), nameOf(photoOf(step), names));
     } catch (const cv::Exception& e) {
-        throw BoothError(ErrorKind::Internal, photo.string(), std::string(name) + " failed in OpenCV: " + e.what());
+        throw FitError(ErrorKind::Internal, photoOf(step), FitFault::Other, nameOf(photoOf(step), names),
+                       std::string(toString(step)) + " failed in OpenCV: " + e.what());
     }
-}
-
-std::string readBytes(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BoothError(ErrorKind::BadInput, path.string(), "cannot be read");
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-std::string photoExtension(const fs::path& p) {
-    std::string ext = p.extension().string();
-    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext == ".jpeg" ? ".jpg" : (ext.empty() ? ".jpg" : ext);
 }
 
 }  // namespace
@@ -76,13 +78,14 @@ std::string photoExtension(const fs::path& p) {
 FitPipeline::FitPipeline(FitSettings settings, const BaseHead& base) : settings_(std::move(settings)), base_(base) {
     const auto t0 = Clock::now();
     detector_ = std::make_unique<LandmarkDetector>(settings_.landmarkModel);
-    // The texture step's per-UV-layout tables, built here with the other one-off loading, not for the first visitor.
-    prepareTexture(base_.mesh, settings_.texture);
+    textureTables_ = std::make_shared<const TextureTables>(base_.mesh, settings_.texture);
+    frontalCheck_ = std::make_shared<FrontalFaceCheck>();
     modelLoadSeconds_ = secondsSince(t0);
 }
 
 FitPipeline::FitPipeline(const FitPipeline& shareFrom, std::unique_ptr<LandmarkDetector> detector)
     : settings_(shareFrom.settings_), base_(shareFrom.base_), detector_(std::move(detector)),
+      textureTables_(shareFrom.textureTables_), frontalCheck_(shareFrom.frontalCheck_),
       modelLoadSeconds_(shareFrom.modelLoadSeconds_) {}
 
 FitPipeline::~FitPipeline() = default;
@@ -91,47 +94,60 @@ std::unique_ptr<FitPipeline> FitPipeline::forAnotherThread() const {
     return std::unique_ptr<FitPipeline>(new FitPipeline(*this, detector_->sharingModel()));
 }
 
-FitOutcome FitPipeline::fit(const FitInputs& inputs) const {
+FitOutcome FitPipeline::fit(const FitPhotoFiles& files, const FitControl& control) const {
+    const FitPhotoNames names = FitPhotoNames::of(files);
+    if (control.cancel.cancelled()) throw FitCancelled();
+    if (control.listener) control.listener(FitStep::ReadPhotos);
     const auto t0 = Clock::now();
     const double cpu0 = processCpuSeconds();
-    const cv::Mat front = readPhoto(inputs.front);
-    const cv::Mat side = readPhoto(inputs.side);
-    const cv::Mat background = inputs.background.empty() ? cv::Mat() : readPhoto(inputs.background);
+    const auto read = [](const fs::path& file, FitPhoto photo) {
+        try {
+            return readPhoto(file);
+        } catch (const BoothError& e) {
+            throw FitError(e, photo, file.string());
+        }
+    };
+    const cv::Mat front = read(files.front, FitPhoto::Front);
+    const cv::Mat side = read(files.side, FitPhoto::Side);
+    const cv::Mat background = files.background.empty() ? cv::Mat() : read(files.background, FitPhoto::Both);
     if (!background.empty() && background.size() != front.size())
-        throw BoothError(ErrorKind::BadInput, inputs.background.string(),
-                         "the background plate is " + std::to_string(background.cols) + "x" + std::to_string(background.rows) +
-                             " but the front photo is " + std::to_string(front.cols) + "x" + std::to_string(front.rows));
+        throw FitError(ErrorKind::BadInput, FitPhoto::Both, FitFault::Other, names.background,
+                       "the background plate is " + std::to_string(background.cols) + "x" + std::to_string(background.rows) +
+                           " but the front photo is " + std::to_string(front.cols) + "x" + std::to_string(front.rows));
     const double readSeconds = secondsSince(t0), readCpuSeconds = processCpuSeconds() - cpu0;
-    FitOutcome out = fit(front, side, background, inputs);
-    out.stageSeconds.insert(out.stageSeconds.begin(), {"read_photos", readSeconds});
-    out.stageCpuSeconds.insert(out.stageCpuSeconds.begin(), {"read_photos", readCpuSeconds});
+    FitOutcome out = fit(front, side, background, names, control);
+    out.stageSeconds.insert(out.stageSeconds.begin(), {toString(FitStep::ReadPhotos), readSeconds});
+    out.stageCpuSeconds.insert(out.stageCpuSeconds.begin(), {toString(FitStep::ReadPhotos), readCpuSeconds});
     return out;
 }
 
-FrontAnalysis FitPipeline::analyseFront(const cv::Mat& front, const cv::Mat& background, const FitInputs& names,
-                                        const StageListener& listener) const {
+FrontAnalysis FitPipeline::analyseFront(const cv::Mat& front, const cv::Mat& background, const FitPhotoNames& names,
+                                        const FitControl& control) const {
     FrontAnalysis a;
     a.photo = front;
     a.background = background;
-    a.landmarks = stage(a, listener, "front_landmarks", names.front, [&] { return detector_->detect(front); });
-    a.mask = stage(a, listener, "front_silhouette", names.front,
-                   [&] { return segmentPerson(front, background, a.landmarks.face); });
+    a.landmarks = runStep(a, control, FitStep::FrontLandmarks, names, [&] { return detector_->detect(front); });
+    a.mask = runStep(a, control, FitStep::FrontSilhouette, names,
+                     [&] { return segmentPerson(front, background, a.landmarks.face); });
     return a;
 }
 
 FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv::Mat& background,
-                            const FitInputs& names, const StageListener& listener, const FrontAnalysis* ahead) const {
+                            const FitPhotoNames& names, const FitControl& control, const FrontAnalysis* ahead) const {
     FitOutcome out;
     out.front = front;
     out.side = side;
     out.background = background;
+    out.rbf = settings_.head.rbf;
+    out.modelLoadSeconds = modelLoadSeconds_;
     if (!background.empty() && background.size() != side.size())
-        throw BoothError(ErrorKind::BadInput, names.side.string(), "the side photo and the background plate differ in size");
+        throw FitError(ErrorKind::BadInput, FitPhoto::Side, FitFault::Other, names.side,
+                       "the side photo and the background plate differ in size");
 
     // The front's analysis made ahead counts only for these very pixels (a retaken front photo is analysed anew).
     const bool useAhead = ahead != nullptr && ahead->photo.data == front.data && ahead->photo.size() == front.size() &&
                           ahead->background.data == background.data;
-    const FrontAnalysis frontAnalysis = useAhead ? *ahead : analyseFront(front, background, names, listener);
+    const FrontAnalysis frontAnalysis = useAhead ? *ahead : analyseFront(front, background, names, control);
     out.frontLandmarks = frontAnalysis.landmarks;
     out.frontMask = frontAnalysis.mask;
     out.stageSeconds = frontAnalysis.stageSeconds;
@@ -142,7 +158,12 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     if (out.frontLandmarks.facesFound > 1)
         out.warnings.push_back(std::to_string(out.frontLandmarks.facesFound) +
                                " faces in the front photo; the largest was used");
-    const SideAnalysis sideAnalysis = stage(out, listener, "side_profile", names.side, [&] { return analyzeSidePhoto(side, background); });
+    const SideAnalysis sideAnalysis =
+        runStep(out, control, FitStep::SideProfile, names, [&] {
+        SideOptions options;
+        options.frontalCheck = frontalCheck_.get();
+        return analyseSidePhoto(side, background, options);
+    });
     out.sideMask = sideAnalysis.mask;
     out.sideNoseImageRight = sideAnalysis.noseImageRight;
     for (const auto& p : sideAnalysis.landmarks) out.sideLandmarks[p.name] = p.px;
@@ -154,10 +175,13 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     m.sidePoints = out.sideLandmarks;
     m.sideMask = out.sideMask;
     m.sideNoseImageRight = out.sideNoseImageRight;
-    out.fit = stage(out, listener, "head_fit", names.side, [&] { return fitHead(base_, m, settings_.head); });
+    out.fit = runStep(out, control, FitStep::HeadFit, names, [&] { return fitHead(base_, m, settings_.head); });
     for (const auto& w : out.fit.warnings) out.warnings.push_back(w);
-    out.texture = stage(out, listener, "texture", fs::path(), [&] {
-        return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture);
+    for (const auto* features : {&base_.frontFeatures, &base_.sideFeatures})
+        for (const auto& [name, v] : *features) out.featurePoints.emplace_back(name, out.fit.mesh.positions[v]);
+    out.texture = runStep(out, control, FitStep::Texture, names, [&] {
+        return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture,
+                                 *textureTables_);
     });
     return out;
 }
@@ -195,110 +219,6 @@ cv::Mat drawSideOverlayWithRays(const FitOutcome& o) {
                     cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 255, 0), 1, cv::LINE_AA);
     }
     return canvas;
-}
-
-std::vector<fs::path> FitPipeline::write(const FitOutcome& o, const FitInputs& inputs, const fs::path& outDir,
-                                         MeshRenderer& renderer, const CharacterOutputs* madeCharacter) const {
-    StagedDirectory dir(outDir, "fit.json");
-    const fs::path s = dir.staging();
-    std::vector<fs::path> written;
-    const auto put = [&](const std::string& name, const std::string& bytes) {
-        writeFileAtomically(s / name, bytes);
-        written.push_back(outDir / name);
-    };
-    const auto t0 = Clock::now();
-    put("avatar.glb", encodeGlb(o.fit.mesh, o.texture.texture, "avatar"));
-    // The photos themselves, as taken (personal data: the files are readable by the booth's user only).
-    put("front" + photoExtension(inputs.front), inputs.front.empty() ? encodeImage(o.front, ".jpg") : readBytes(inputs.front));
-    put("side" + photoExtension(inputs.side), inputs.side.empty() ? encodeImage(o.side, ".jpg") : readBytes(inputs.side));
-    put("front_overlay.jpg", encodeImage(drawFrontOverlay(o), ".jpg"));
-    put("side_overlay.jpg", encodeImage(drawSideOverlayWithRays(o), ".jpg"));
-    const double exportSeconds = secondsSince(t0);
-
-    const auto t1 = Clock::now();
-    renderer.upload(o.fit.mesh, o.texture.texture);
-    const PreviewSet previews = renderPreviews(renderer, o.fit.mesh, settings_.previewSize);
-    put("preview_front.png", encodeImage(previews.front, ".png"));
-    put("preview_side.png", encodeImage(previews.side, ".png"));
-    put("preview_three_quarter.png", encodeImage(previews.threeQuarter, ".png"));
-    const double previewSeconds = secondsSince(t1);
-
-    nlohmann::json landmarks;
-    landmarks["pixel_convention"] = "pixel centres at integer coordinates";
-    for (int k = 0; k < 68; ++k) {
-        const auto& p = o.frontLandmarks.points[static_cast<std::size_t>(k)];
-        landmarks["front"][landmarkName(k)] = {p.x, p.y};
-    }
-    landmarks["front_face_box"] = {o.frontLandmarks.face.x, o.frontLandmarks.face.y, o.frontLandmarks.face.width,
-                                   o.frontLandmarks.face.height};
-    for (const auto& [name, p] : o.sideLandmarks) landmarks["side"][name] = {p.x, p.y};
-    landmarks["side_nose_points"] = o.sideNoseImageRight ? "image-right" : "image-left";
-    landmarks["units_3d"] = "millimetres; y up, face along +z, x to the subject's left, origin between the ear holes";
-    for (const auto& [name, v] : base_.frontFeatures) {
-        const auto& p = o.fit.mesh.positions[v];
-        landmarks["points_3d"][name] = {p.x, p.y, p.z};
-    }
-    for (const auto& [name, v] : base_.sideFeatures) {
-        const auto& p = o.fit.mesh.positions[v];
-        landmarks["points_3d"][name] = {p.x, p.y, p.z};
-    }
-    put("landmarks.json", landmarks.dump(2) + "\n");
-
-    // Character maker (issue 6, app/character/): Narita's proportions and the stylised character head.
-    const auto tCharacter = Clock::now();
-    CharacterOutputs madeHere;
-    if (settings_.characterEnabled && !madeCharacter) madeHere = makeCharacter(o);
-    const CharacterOutputs& character = madeCharacter ? *madeCharacter : madeHere;
-    if (settings_.characterEnabled) {
-        put("character.json", character.json);
-        put("character.glb", character.glb);
-    }
-    const double characterSeconds = secondsSince(tCharacter);
-
-    nlohmann::json report;
-    report["version"] = AVATARBOOTH_VERSION;
-    report["inputs"] = {{"front", inputs.front.string()}, {"side", inputs.side.string()},
-                        {"background", inputs.background.string()}};
-    report["rbf"] = {{"kernel", rbfKernelName(settings_.head.rbf.kernel)}, {"unit_mm", settings_.head.rbf.unitMm},
-                     {"gaussian_sigma", settings_.head.rbf.gaussianSigma}, {"regularisation", settings_.head.rbf.regularisation}};
-    report["axis_scale"] = {o.fit.axisScale.x, o.fit.axisScale.y, o.fit.axisScale.z};
-    report["mm_per_pixel"] = {{"front", o.fit.front.mmPerPixel}, {"side", o.fit.side.mmPerPixel}};
-    report["texture_seen_fraction"] = o.texture.seenFraction;
-    report["model_load_seconds"] = modelLoadSeconds_;
-    nlohmann::json stages = nlohmann::json::array();
-    double total = 0.0;
-    for (const auto& [name, seconds] : o.stageSeconds) {
-        stages.push_back({{"stage", name}, {"seconds", seconds}});
-        total += seconds;
-    }
-    stages.push_back({{"stage", "export"}, {"seconds", exportSeconds}});
-    stages.push_back({{"stage", "previews"}, {"seconds", previewSeconds}});
-    stages.push_back({{"stage", "character"}, {"seconds", characterSeconds}});
-    report["stages"] = stages;
-    report["fit_seconds"] = total;
-    nlohmann::json residuals = nlohmann::json::array();
-    double worst = 0.0, sum = 0.0;
-    for (const auto& r : o.fit.residuals) {
-        residuals.push_back({{"name", r.name}, {"view", r.view}, {"measured_mm", {r.measured.x, r.measured.y}},
-                             {"fitted_mm", {r.fitted.x, r.fitted.y}}, {"error_mm", r.errorMm}});
-        worst = std::max(worst, r.errorMm);
-        sum += r.errorMm * r.errorMm;
-    }
-    report["residuals"] = residuals;
-    report["residual_rms_mm"] = o.fit.residuals.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(o.fit.residuals.size()));
-    report["residual_max_mm"] = worst;
-    report["warnings"] = o.warnings;
-    for (const auto& w : character.warnings) report["warnings"].push_back("character: " + w);
-    // fit.json last: its presence marks a complete result.
-    put("fit.json", report.dump(2) + "\n");
-    dir.commit();
-    return written;
-}
-
-CharacterOutputs FitPipeline::makeCharacter(const FitOutcome& o) const {
-    if (!settings_.characterEnabled) return {};
-    return makeCharacterOutputs(o.front, o.frontLandmarks.points, o.frontMask,
-                                earHoleInFrontPhoto(o.fit, o.sideLandmarks), base_, settings_.character);
 }
 
 }  // namespace avatarbooth

@@ -1,20 +1,24 @@
-// The whole photo-to-head pipeline, as `avatarbooth fit` (and later the kiosk and batch runs) use it:
-// read photos -> front landmarks + silhouette -> side profile -> fit -> texture -> previews -> session folder.
+// The photo-to-head pipeline as free of any booth as it can be: photos in, a fitted and textured head out, in
+// memory (read photos -> front landmarks + silhouette -> side profile -> head fit -> texture). Writing the session
+// folder is booth/session_folder.h's; the character is made from the outcome by reveal/character.
 #pragma once
 
-#include "reveal/character/character_outputs.h"
 #include "fit/face/landmarks68.h"
+#include "fit/face/profile.h"
+#include "fit/fit_error.h"
+#include "fit/fit_step.h"
 #include "fit/head/base_head.h"
 #include "fit/head/head_fit.h"
 #include "fit/head/photo_texture.h"
-#include "render/mesh_renderer.h"
 
-#include <nlohmann/json.hpp>
+#include <glm/glm.hpp>
 #include <opencv2/core.hpp>
 
+#include <atomic>
 #include <filesystem>
-#include <functional>
+#include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -25,14 +29,19 @@ struct FitSettings {
     std::filesystem::path landmarkModel = AVATARBOOTH_DEFAULT_DLIB_MODEL;
     HeadFitOptions head = defaultHeadFitOptions();
     PhotoTextureOptions texture;
-    int previewSize = 512;
-    // The character avatar (issue 6): character.json + character.glb in every session when enabled ([character]).
-    bool characterEnabled = true;
-    CharacterSettings character;
 };
 
-struct FitInputs {
+// The files one fit reads.
+struct FitPhotoFiles {
     std::filesystem::path front, side, background;  // background may be empty
+};
+
+// How errors and fit.json name the photos: the files' paths, or (photos in memory) what they are.
+struct FitPhotoNames {
+    std::string front = "front photo", side = "side photo", background = "background plate";
+    static FitPhotoNames of(const FitPhotoFiles& files) {
+        return {files.front.string(), files.side.string(), files.background.string()};
+    }
 };
 
 // Everything one fit produced, in memory.
@@ -45,14 +54,18 @@ struct FitOutcome {
     cv::Mat sideMask;
     HeadFit fit;
     PhotoTexture texture;
-    std::vector<std::pair<std::string, double>> stageSeconds;  // in order
+    // The base head's named feature vertices where the fit put them (head-space millimetres).
+    std::vector<std::pair<std::string, glm::dvec3>> featurePoints;
+    RbfOptions rbf;                 // the warp the fit used
+    double modelLoadSeconds = 0.0;  // of the pipeline that fitted it
+    std::vector<std::pair<std::string, double>> stageSeconds;  // in order, named by toString(FitStep)
     // Processor time of each stage, all threads together (on a shared machine wall times vary with the load; this
     // is the work itself). Same order and names as stageSeconds.
     std::vector<std::pair<std::string, double>> stageCpuSeconds;
     std::vector<std::string> warnings;
 };
 
-// The front photo's analysis (landmarks, silhouette): fit()'s first two stages, which a booth runs as soon as the
+// The front photo's analysis (landmarks, silhouette): fit()'s first two steps, which a booth runs as soon as the
 // front photo is taken, while the visitor turns for the side photo.
 struct FrontAnalysis {
     cv::Mat photo;  // the very image analysed: fit() uses the analysis only for a front photo sharing its pixels
@@ -62,9 +75,27 @@ struct FrontAnalysis {
     std::vector<std::pair<std::string, double>> stageSeconds, stageCpuSeconds;
 };
 
-// Told the name of each stage as it starts ("front_landmarks", "front_silhouette", "side_profile", "head_fit",
-// "texture"), from the fitting thread: the kiosk shows progress with it.
-using StageListener = std::function<void(const std::string& stage)>;
+// Cancels a fit from another thread (or a signal handler: it only reads an atomic flag). Default: never.
+class CancelToken {
+public:
+    CancelToken() = default;
+    explicit CancelToken(const std::atomic<bool>& cancelled) : cancelled_(&cancelled) {}
+    bool cancelled() const { return cancelled_ != nullptr && cancelled_->load(std::memory_order_relaxed); }
+
+private:
+    const std::atomic<bool>* cancelled_ = nullptr;  // owned by the canceller, who keeps it alive during the fit
+};
+
+// Thrown by fit() and analyseFront() once their token is cancelled: between two steps, never in one.
+struct FitCancelled : std::runtime_error {
+    FitCancelled() : std::runtime_error("the fit was cancelled") {}
+};
+
+// How a fit is run: who hears of each step, and the token that cancels it.
+struct FitControl {
+    FitStepListener listener;
+    CancelToken cancel;
+};
 
 class FitPipeline {
 public:
@@ -74,6 +105,7 @@ public:
 
     double modelLoadSeconds() const { return modelLoadSeconds_; }
     const BaseHead& baseHead() const { return base_; }
+    const FitSettings& settings() const { return settings_; }
     // The loaded landmark detector, for the kiosk's preview guidance (not while a fit runs: one user at a time).
     const LandmarkDetector& detector() const { return *detector_; }
 
@@ -81,28 +113,15 @@ public:
     // texture tables, with a face detector of its own (see LandmarkDetector::sharingModel). Cheap: no loading.
     std::unique_ptr<FitPipeline> forAnotherThread() const;
 
-    // Reads, analyses, fits and textures. Errors are BoothErrors naming the photo they concern.
-    FitOutcome fit(const FitInputs& inputs) const;
-    // The same on photos already in memory (names are used in error messages).
-    // `ahead`: the front photo's analysis made earlier (analyseFront), used when it is of this front photo and
-    // background (else the front is analysed here).
-    FitOutcome fit(const cv::Mat& front, const cv::Mat& side, const cv::Mat& background,
-                   const FitInputs& names = {}, const StageListener& listener = {},
-                   const FrontAnalysis* ahead = nullptr) const;
-    // The front photo's landmarks and silhouette alone (BoothError NoFace naming the photo when there is no face).
-    FrontAnalysis analyseFront(const cv::Mat& front, const cv::Mat& background, const FitInputs& names = {},
-                               const StageListener& listener = {}) const;
-
-    // Writes the session folder atomically: it is complete, or absent (an earlier result stays as it was).
-    // Returns the paths of what was written. The renderer makes the previews. `character`: the character outputs
-    // made beforehand with makeCharacter (the kiosk shows the head before the folder is written); made here when
-    // null.
-    std::vector<std::filesystem::path> write(const FitOutcome& outcome, const FitInputs& inputs,
-                                             const std::filesystem::path& out, MeshRenderer& renderer,
-                                             const CharacterOutputs* character = nullptr) const;
-    // The character maker's outputs for a fit (character.json, character.glb and the head itself); empty when the
-    // character is off ([character] enabled = false).
-    CharacterOutputs makeCharacter(const FitOutcome& outcome) const;
+    // Reads, analyses, fits and textures. Errors are FitErrors naming the photo they concern.
+    FitOutcome fit(const FitPhotoFiles& files, const FitControl& control = {}) const;
+    // The same on photos already in memory. `ahead`: the front photo's analysis made earlier (analyseFront), used
+    // when it is of this front photo and background (else the front is analysed here).
+    FitOutcome fit(const cv::Mat& front, const cv::Mat& side, const cv::Mat& background, const FitPhotoNames& names = {},
+                   const FitControl& control = {}, const FrontAnalysis* ahead = nullptr) const;
+    // The front photo's landmarks and silhouette alone (FitError NoFace about the front when there is no face).
+    FrontAnalysis analyseFront(const cv::Mat& front, const cv::Mat& background, const FitPhotoNames& names = {},
+                               const FitControl& control = {}) const;
 
 private:
     FitPipeline(const FitPipeline& shareFrom, std::unique_ptr<LandmarkDetector> detector);
@@ -110,6 +129,8 @@ private:
     FitSettings settings_;
     const BaseHead& base_;
     std::unique_ptr<LandmarkDetector> detector_;
+    std::shared_ptr<const TextureTables> textureTables_;  // shared with the pipelines forAnotherThread() made
+    std::shared_ptr<FrontalFaceCheck> frontalCheck_;      // likewise (it is thread-safe)
     double modelLoadSeconds_ = 0.0;
 };
 

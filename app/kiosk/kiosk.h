@@ -2,8 +2,10 @@
 // session store, and runs the main loop (`avatarbooth run`).
 //
 // One thread runs the loop (events in, flow, commands out, one screen per frame); the landmark model loads, the
-// preview is analysed and the fit runs on worker threads, so the screen never stops. The flow itself
-// (booth/visitor_flow.h) is plain logic; everything here is the plumbing around it.
+// preview is analysed, the fit runs and the session folder is written on worker threads (fit_worker.h,
+// preview_worker.h, session_writer.h), which post to one queue the loop waits on between frames, so the screen
+// never stops. The visitor flow (booth/visitor_flow.h) and the session folder's life (booth/session_lifecycle.h)
+// are plain logic; kiosk.cpp is the plumbing between them and the devices.
 #pragma once
 
 #include "booth/flow_types.h"
@@ -86,11 +88,5 @@ void tuneAllocatorForKiosk();
 // Runs the booth until options.sessions have ended or options.stop is set. Throws BoothError when a device or the
 // configuration cannot be used at start-up (a camera lost later is waited for, not fatal).
 KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options);
-
-// True once runKiosk has returned (or thrown) while the landmark model was still loading: dlib's deserialisation
-// cannot be interrupted, so that thread was left running rather than joined (stopping must not wait minutes). The
-// process must then end with std::quick_exit (after flushing its output), not exit(): static destructors would run
-// under the still-running load.
-bool kioskLeftAThreadRunning();
 
 }  // namespace avatarbooth

@@ -3,7 +3,9 @@
 #include "test_paths.h"
 
 #include "fit/export/glb.h"
+#include "booth/session_folder.h"
 #include "fit/fit_pipeline.h"
+#include "render/mesh_renderer.h"
 
 #include <gtest/gtest.h>
 
@@ -33,10 +35,10 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
     char person[8];
     std::snprintf(person, sizeof person, "%03d", std::get<0>(GetParam()));
     const fs::path dir = test::sharedData() / "frmdb" / person;
-    const FitInputs inputs{dir / "Img_33.jpg", dir / std::get<1>(GetParam()), {}};
+    const FitPhotoFiles inputs{dir / "Img_33.jpg", dir / std::get<1>(GetParam()), {}};
     const FitOutcome outcome = pipeline().fit(inputs);
     const fs::path out = test::scratchDir(std::string("frmdb_") + person + "_" + std::get<1>(GetParam())) / "session";
-    pipeline().write(outcome, inputs, out, renderer());
+    writeSessionFolder(outcome, {inputs}, out, renderer());
     std::printf("%s %s: overlays and previews in %s (%zu warnings)\n", person, std::get<1>(GetParam()), out.c_str(),
                 outcome.warnings.size());
     EXPECT_TRUE(fs::exists(out / "front_overlay.jpg"));

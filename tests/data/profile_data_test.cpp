@@ -20,7 +20,7 @@
 
 namespace {
 
-using avatarbooth::analyzeSidePhoto;
+using avatarbooth::analyseSidePhoto;
 using avatarbooth::profilePoint;
 using avatarbooth::SideAnalysis;
 namespace fs = std::filesystem;
@@ -72,7 +72,7 @@ TEST(ProfileData, FrmdbProfilesBothDirections) {
             SideAnalysis a;
             const auto t0 = std::chrono::steady_clock::now();
             try {
-                a = analyzeSidePhoto(bgr);
+                a = analyseSidePhoto(bgr);
             } catch (const avatarbooth::BoothError& e) {
                 ADD_FAILURE() << "refused: " << e.what();
                 continue;
@@ -109,7 +109,7 @@ TEST(ProfileData, FrmdbFrontsAreRefusedAsFrontViews) {
         const cv::Mat bgr = cv::imread((avatarbooth::test::sharedData() / "frmdb" / id / "Img_33.jpg").string());
         ASSERT_FALSE(bgr.empty());
         try {
-            (void)analyzeSidePhoto(bgr);
+            (void)analyseSidePhoto(bgr);
             ADD_FAILURE() << "a front photo was accepted as a profile";
         } catch (const avatarbooth::BoothError& e) {
             EXPECT_EQ(e.kind(), avatarbooth::ErrorKind::Mismatch) << e.what();
@@ -119,7 +119,7 @@ TEST(ProfileData, FrmdbFrontsAreRefusedAsFrontViews) {
         avatarbooth::SideOptions silhouetteOnly;
         silhouetteOnly.rejectFrontViews = false;
         try {
-            (void)analyzeSidePhoto(bgr, cv::Mat(), silhouetteOnly);
+            (void)analyseSidePhoto(bgr, cv::Mat(), silhouetteOnly);
             std::cout << "[ " << id << "/Img_33 ] silhouette alone: accepted (the face detector refuses it)\n";
         } catch (const avatarbooth::BoothError& e) {
             std::cout << "[ " << id << "/Img_33 ] silhouette alone: refused (" << e.what() << ")\n";
@@ -233,7 +233,7 @@ void checkScanProfile(const std::string& view, bool noseRight) {
     const cv::Mat bgr = cv::imread((scanDir() / "renders" / ("LeePerrySmith_" + view + "_rgb.png")).string());
     ASSERT_FALSE(bgr.empty());
     const auto t0 = std::chrono::steady_clock::now();
-    const SideAnalysis a = analyzeSidePhoto(bgr);
+    const SideAnalysis a = analyseSidePhoto(bgr);
     const double ms = millisecondsSince(t0);
     EXPECT_EQ(a.noseImageRight, noseRight);
     cv::Mat overlay = bgr.clone();
@@ -272,7 +272,7 @@ TEST(ProfileData, ScanRightProfileMatchesMeshLandmarks) {
     // Ear hole: marked by hand on the +090 render (the opening behind the tragus) at (466, 652); the estimate is a
     // proportion rule (profile.cpp), expected within 6% of the head height here.
     const cv::Mat bgr = cv::imread((scanDir() / "renders" / "LeePerrySmith_yaw+090_rgb.png").string());
-    const SideAnalysis a = analyzeSidePhoto(bgr);
+    const SideAnalysis a = analyseSidePhoto(bgr);
     const double headHeight = profilePoint(a.landmarks, "chin").y - profilePoint(a.landmarks, "top_of_head").y;
     const double err = cv::norm(profilePoint(a.landmarks, "ear_hole") - cv::Point2d(466, 652));
     std::cout << "    ear_hole (hand-marked): error " << err << " px = " << 100.0 * err / headHeight << "%\n";
@@ -289,7 +289,7 @@ TEST(ProfileData, ScanFrontIsRefusedAsFrontView) {
     const cv::Mat bgr = cv::imread((scanDir() / "renders" / "LeePerrySmith_yaw+000_rgb.png").string());
     ASSERT_FALSE(bgr.empty());
     try {
-        (void)analyzeSidePhoto(bgr);
+        (void)analyseSidePhoto(bgr);
         ADD_FAILURE() << "the scan's front render was accepted as a profile";
     } catch (const avatarbooth::BoothError& e) {
         EXPECT_EQ(e.kind(), avatarbooth::ErrorKind::Mismatch) << e.what();

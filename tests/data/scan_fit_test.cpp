@@ -4,7 +4,9 @@
 
 #include "fit/export/glb.h"
 #include "fit/head/shape_compare.h"
+#include "booth/session_folder.h"
 #include "fit/fit_pipeline.h"
+#include "render/mesh_renderer.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/flann.hpp>
@@ -60,10 +62,10 @@ TEST(ScanFit, FittedHeadIsNearerTheScanThanTheBaseHead) {
     AVATARBOOTH_REQUIRE_SHARED_DATA();
     const fs::path dir = test::sharedData() / "scan_lee_perry_smith";
     const FitPipeline pipeline{FitSettings{}};
-    const FitInputs inputs{dir / "renders" / "LeePerrySmith_yaw+000_rgb.png", dir / "renders" / "LeePerrySmith_yaw+090_rgb.png", {}};
+    const FitPhotoFiles inputs{dir / "renders" / "LeePerrySmith_yaw+000_rgb.png", dir / "renders" / "LeePerrySmith_yaw+090_rgb.png", {}};
     static MeshRenderer renderer;
     const FitOutcome out = pipeline.fit(inputs);
-    pipeline.write(out, inputs, test::scratchDir("scan_fit") / "session", renderer);
+    writeSessionFolder(out, {inputs}, test::scratchDir("scan_fit") / "session", renderer);
 
     const BaseHead& base = pipeline.baseHead();
     const Mesh& fitted = out.fit.mesh;

@@ -5,6 +5,7 @@
 #include "reveal/character/character_head.h"
 #include "reveal/character/character_outputs.h"
 #include "fit/export/glb.h"
+#include "booth/session_folder.h"
 #include "fit/fit_pipeline.h"
 #include "sim/synthetic_visitor.h"
 #include "test_paths.h"
@@ -74,9 +75,10 @@ TEST(CharacterSession, AFitWritesTheCharacterFilesBeforeFitJson) {
     const fs::path dir = test::scratchDir("character_session");
     writeSyntheticVisitorFolder(v, dir / "visitor");
     FitPipeline pipeline(FitSettings{});
-    const FitInputs inputs{dir / "visitor" / "front.jpg", dir / "visitor" / "side.jpg", dir / "visitor" / "background.png"};
+    const FitPhotoFiles inputs{dir / "visitor" / "front.jpg", dir / "visitor" / "side.jpg", dir / "visitor" / "background.png"};
     const FitOutcome outcome = pipeline.fit(inputs);
-    const std::vector<fs::path> written = pipeline.write(outcome, inputs, dir / "session", renderer());
+    const CharacterOutputs character = makeCharacterOutputs(outcome, base);
+    const std::vector<fs::path> written = writeSessionFolder(outcome, {inputs, &character}, dir / "session", renderer());
 
     ASSERT_FALSE(written.empty());
     EXPECT_EQ(written.back().filename(), "fit.json");

@@ -1,9 +1,12 @@
 // Integration tests of the reveal's styles: the stage view (R(theta) sweep, one render per angle), the character and
 // toon renderers through RevealStyles on the synthetic visitor, the toon strip kept, and the screens' layout of them.
 #include "reveal/character/character_head.h"
+#include "reveal/character/character_outputs.h"
+#include "fit/fit_pipeline.h"
 #include "common/error.h"
 #include "fit/face/silhouette.h"
 #include "fit/head/base_head.h"
+#include "booth/screens/screens.h"
 #include "reveal/styles/reveal_styles.h"
 #include "render/mesh_renderer.h"
 #include "sim/synthetic_visitor.h"
@@ -17,6 +20,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <mutex>
 #include <thread>
 
 namespace avatarbooth {
@@ -111,6 +115,57 @@ struct Visitor {
     cv::Mat frontMask, sideMask;
 };
 
+// The styles' work for a visitor, run on a thread of its own as the kiosk's style worker does; what it posts is
+// run by drain() on the test's thread (the screen's, in the kiosk).
+class StyleWorkRunner {
+public:
+    explicit StyleWorkRunner(std::vector<StyleWork> work)
+        : thread_([this, work = std::move(work)] {
+              const StylePost post = [this](std::function<void()> f) {
+                  std::lock_guard lock(mutex_);
+                  posted_.push_back(std::move(f));
+              };
+              for (const auto& w : work) w(post);
+          }) {}
+    ~StyleWorkRunner() { thread_.join(); }
+    void drain() {
+        std::vector<std::function<void()>> ready;
+        {
+            std::lock_guard lock(mutex_);
+            ready.swap(posted_);
+        }
+        for (auto& f : ready) f();
+    }
+
+private:
+    std::mutex mutex_;
+    std::vector<std::function<void()>> posted_;
+    std::thread thread_;
+};
+
+// Until the styles have settled (their work done and handed over), at most `limit`.
+void settle(RevealStyles& styles, StyleWorkRunner& runner, std::chrono::milliseconds limit) {
+    for (auto waited = 0ms; waited < limit && !styles.settled(); waited += 20ms) {
+        std::this_thread::sleep_for(20ms);
+        runner.drain();
+    }
+}
+
+// A fit as the pipeline hands it over: the visitor's photos, masks, true landmarks and head with its texture.
+FitOutcome fitOf(const Visitor& visitor) {
+    FitOutcome fit;
+    fit.front = visitor.v.front;
+    fit.frontMask = visitor.frontMask;
+    fit.side = visitor.v.side;
+    fit.sideMask = visitor.sideMask;
+    fit.sideNoseImageRight = SyntheticVisitorOptions{}.sideNoseImageRight;
+    for (int k = 0; k < 68; ++k) fit.frontLandmarks.points[static_cast<std::size_t>(k)] = visitor.v.frontLandmarks.at(cv::format("ibug_%02d", k));
+    fit.sideLandmarks = visitor.v.sideLandmarks;
+    fit.fit.mesh = visitor.v.truthMesh;
+    fit.texture.texture = visitor.v.texture;
+    return fit;
+}
+
 const Visitor& syntheticVisitor() {
     static const Visitor visitor = [] {
         MeshRenderer renderer;
@@ -129,63 +184,56 @@ TEST(RevealStyles, CharacterToonAndStageOnTheRevealThenTheStripIsKept) {
     RevealSettings reveal;  // photo, character, toon
     reveal.toonStripFrames = 5;
     StageSettings stageSettings;
-    RevealStyles styles(reveal, stageSettings, AnimationSettings{}, builtinBaseHead(), 480);
+    RevealStyles styles(reveal, stageSettings, AnimationSettings{}, builtinBaseHead());
 
-    // Before any visitor: the photo style is what the kiosk passes, the character is the painted base head, no toon.
-    const ScreenLayout layout = [] {
-        ScreenLayout l;
-        l.stage = cv::Rect(0, 288, 1280, 288);
-        return l;
-    }();
-    ScreenInputs in;
-    in.avatar = cv::Mat(480, 480, CV_8UC3, cv::Scalar(1, 2, 3));
-    styles.fill(in, /*reveal=*/false, 0ms, layout);
+    // Before any visitor: the photo style and the character are the base head (untextured, painted), no toon.
+    const cv::Size band(1280, 288);
+    const std::vector<int> sizes{480, 480, 480};
+    StyleImages in;
+    styles.fill(in, /*reveal=*/false, 0ms, sizes, band);
     ASSERT_EQ(in.avatars.size(), 2u);
     EXPECT_EQ(in.avatars[0].style, "photo");
+    EXPECT_EQ(in.avatars[0].image.size(), cv::Size(480, 480));
+    EXPECT_GT(alphaCoverage(in.avatars[0].image), 0.15);
+    EXPECT_TRUE(styles.photoShown());
     EXPECT_EQ(in.avatars[1].style, "character");
     const double baseCharacter = alphaCoverage(in.avatars[1].image);
     EXPECT_GT(baseCharacter, 0.15);
     EXPECT_LT(baseCharacter, 0.8);
-    EXPECT_EQ(in.stage.size(), layout.stage.size() / 2);  // half resolution, scaled up by the screen
+    EXPECT_EQ(in.stage.size(), band / 2);  // half resolution, scaled up by the screen
     EXPECT_GT(alphaCoverage(in.stage), 0.2);
 
     // A visitor: a character made by the pipeline's code, their toon drawn in the background.
     const BaseHead& base = builtinBaseHead();
     const CharacterProportions average = measureHead(base.mesh, base, base.earHoleCentre).proportions;
-    CharacterHead character = makeCharacterHead(base, average, CharacterSettings{});
-    StyleInputs inputs;
-    inputs.front = visitor.v.front;
-    inputs.frontMask = visitor.frontMask;
-    inputs.side = visitor.v.side;
-    inputs.sideMask = visitor.sideMask;
-    inputs.sideNoseImageRight = SyntheticVisitorOptions{}.sideNoseImageRight;
-    inputs.sideChinRow = static_cast<int>(visitor.v.sideLandmarks.at("chin").y) + 1;
-    styles.visitor(inputs);
+    CharacterOutputs character;
+    character.head = makeCharacterHead(base, average, CharacterSettings{});
+    StyleWorkRunner runner(styles.visitor(fitOf(visitor)));
 
     // At once: the character's place is there, empty, until the kiosk hands over the visitor's character (never
     // the previous one's); the toon's place is there, empty, while it is drawn; the reveal is not complete yet.
     std::uint64_t version = styles.version();
-    styles.fill(in, /*reveal=*/true, 0ms, layout);
+    styles.fill(in, /*reveal=*/true, 0ms, sizes, band);
     ASSERT_EQ(in.avatars.size(), 3u);
     EXPECT_TRUE(in.avatars[1].image.empty());
     EXPECT_FALSE(styles.complete());
     EXPECT_NE(styles.version(), version);  // a style's image went
-    styles.fill(in, /*reveal=*/false, 0ms, layout);
-    EXPECT_EQ(in.avatars.size(), 1u);  // attract: no empty places
-    styles.visitorCharacter(character.mesh, character.texture);
+    styles.fill(in, /*reveal=*/false, 0ms, sizes, band);
+    EXPECT_EQ(in.avatars.size(), 1u);  // attract: no empty places (the photo style shows the visitor's head)
+    styles.visitorCharacter(&character);
     version = styles.version();
-    styles.fill(in, /*reveal=*/true, 0ms, layout);
+    styles.fill(in, /*reveal=*/true, 0ms, sizes, band);
     ASSERT_EQ(in.avatars.size(), 3u);
     EXPECT_GT(alphaCoverage(in.avatars[1].image), 0.15);
     EXPECT_NE(styles.version(), version);
     const bool drawnAlready = !in.avatars[2].image.empty();
     EXPECT_EQ(styles.complete(), drawnAlready);
-    for (int i = 0; i < 600 && !styles.toonSettled(); ++i) std::this_thread::sleep_for(50ms);
-    ASSERT_TRUE(styles.toonSettled());
+    settle(styles, runner, 30s);
+    ASSERT_TRUE(styles.settled());
 
     // Every style has its image at several moments of the turn; the toon covers a head's worth of its image.
     for (const auto since : {0ms, 1500ms, 3000ms}) {
-        styles.fill(in, /*reveal=*/true, since, layout);
+        styles.fill(in, /*reveal=*/true, since, sizes, band);
         ASSERT_EQ(in.avatars.size(), 3u);
         EXPECT_TRUE(styles.complete());
         EXPECT_EQ(in.avatars[2].style, "toon");
@@ -200,13 +248,13 @@ TEST(RevealStyles, CharacterToonAndStageOnTheRevealThenTheStripIsKept) {
 
     // A held frame reuses the images (no new render).
     const StyleFigures before = styles.figures();
-    styles.fill(in, true, 3000ms, layout);
+    styles.fill(in, true, 3000ms, sizes, band);
     const StyleFigures after = styles.figures();
     EXPECT_EQ(after.characterRenders, before.characterRenders);
     EXPECT_EQ(after.toonRenders, before.toonRenders);
     EXPECT_EQ(after.stageRenders, before.stageRenders);
     const std::uint64_t held = styles.version();
-    styles.fill(in, true, 3000ms, layout);
+    styles.fill(in, true, 3000ms, sizes, band);
     EXPECT_EQ(styles.version(), held);  // nothing changed: the screen need not compose the reveal again
     std::printf("per render (medians, this machine): character %.1f ms, toon %.1f ms, stage %.1f ms; toon drawn in %.2f s\n",
                 after.characterMs, after.toonMs, after.stageMs, after.toonBuildSeconds);
@@ -214,7 +262,7 @@ TEST(RevealStyles, CharacterToonAndStageOnTheRevealThenTheStripIsKept) {
     // Kept: the strip goes into the session folder.
     const std::filesystem::path session = dir / "session";
     std::filesystem::create_directories(session);
-    ASSERT_TRUE(styles.writeToonStrip(session));
+    ASSERT_TRUE(styles.writeInto(session));
     for (int i = 0; i < 5; ++i) {
         const cv::Mat frame = cv::imread((session / "toon" / cv::format("turntable_%03d.png", i)).string());
         ASSERT_FALSE(frame.empty()) << i;
@@ -228,22 +276,23 @@ TEST(RevealStyles, AToonThatCannotBeDrawnSettlesWithoutAPlace) {
     reveal.styles = {AvatarStyle::Photo, AvatarStyle::Toon};
     StageSettings noStage;
     noStage.enabled = false;
-    RevealStyles styles(reveal, noStage, AnimationSettings{}, builtinBaseHead(), 240);
-    StyleInputs inputs;
-    inputs.front = cv::Mat(100, 100, CV_8UC3, cv::Scalar::all(128));
-    inputs.frontMask = cv::Mat::zeros(100, 100, CV_8U);  // no head: toonFromPhotos refuses
-    inputs.side = inputs.front;
-    inputs.sideMask = inputs.frontMask;
-    styles.visitor(inputs);
-    for (int i = 0; i < 200 && !styles.toonSettled(); ++i) std::this_thread::sleep_for(20ms);
-    ASSERT_TRUE(styles.toonSettled());
-    ScreenInputs in;
-    in.avatar = cv::Mat(10, 10, CV_8UC3);
-    styles.fill(in, true, 0ms, ScreenLayout{});
+    RevealStyles styles(reveal, noStage, AnimationSettings{}, builtinBaseHead());
+    FitOutcome fit;
+    fit.front = cv::Mat(100, 100, CV_8UC3, cv::Scalar::all(128));
+    fit.frontMask = cv::Mat::zeros(100, 100, CV_8U);  // no head: toonFromPhotos refuses
+    fit.side = fit.front;
+    fit.sideMask = fit.frontMask;
+    fit.fit.mesh = builtinBaseHead().mesh;
+    fit.texture.texture = cv::Mat(8, 8, CV_8UC3, cv::Scalar::all(128));
+    StyleWorkRunner runner(styles.visitor(fit));
+    settle(styles, runner, 4s);
+    ASSERT_TRUE(styles.settled());
+    StyleImages in;
+    styles.fill(in, true, 0ms, {64, 64}, cv::Size());
     ASSERT_EQ(in.avatars.size(), 1u);
     EXPECT_EQ(in.avatars[0].style, "photo");
     EXPECT_TRUE(in.stage.empty());
-    EXPECT_FALSE(styles.writeToonStrip(test::scratchDir("reveal_styles_nothing")));
+    EXPECT_FALSE(styles.writeInto(test::scratchDir("reveal_styles_nothing")));
 }
 
 TEST(RevealStyles, ABrokenStageMapIsAConfigErrorWithLineAndColumn) {
@@ -254,7 +303,7 @@ TEST(RevealStyles, ABrokenStageMapIsAConfigErrorWithLineAndColumn) {
     StageSettings s;
     s.map = map;
     try {
-        RevealStyles styles(RevealSettings{}, s, AnimationSettings{}, builtinBaseHead(), 240);
+        RevealStyles styles(RevealSettings{}, s, AnimationSettings{}, builtinBaseHead());
         FAIL() << "no error";
     } catch (const BoothError& e) {
         EXPECT_EQ(e.kind(), ErrorKind::BadConfig);

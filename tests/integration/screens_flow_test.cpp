@@ -61,12 +61,12 @@ TEST(ScreensFlow, ScriptedSessionDrawsEveryScreen) {
     press(Button::Start);                                              // -> countdown
     send(Tick{at(t + 3.0)});                                           // -> capture
     send(CaptureDone{Photo::Side, at(t + 0.2)});                       // -> processing
-    send(FitProgress{0.3, "front_landmarks", at(t + 0.3)});
+    send(FitProgress{FitStep::FrontLandmarks, at(t + 0.3)});
     send(FitFailed{RetakeWhich::Side, FitFailure::NotProfile, "side.jpg: a front view", at(t + 0.3)});
     press(Button::Start);                                              // side guide -> countdown
     send(Tick{at(t + 3.0)});
     send(CaptureDone{Photo::Side, at(t + 0.2)});                       // -> processing
-    send(FitProgress{0.8, "texture", at(t + 0.5)});
+    send(FitProgress{FitStep::Texture, at(t + 0.5)});
     send(FitDone{at(t + 0.5)});                                        // -> reveal
     press(Button::Retake);                                             // -> retake choice
     send(Tick{at(t + 20.0)});                                          // -> reveal again

@@ -132,7 +132,7 @@ std::vector<Case> allScreens() {
     add("processing", [](ScreenModel& m) {
         m.id = ScreenId::Processing;
         m.progress = 0.55;
-        m.stage = "head_fit";
+        m.fitStep = FitStep::HeadFit;
         m.sinceEntered = Millis(1700);
     });
     add("reveal", [](ScreenModel& m) { m.id = ScreenId::Reveal; });

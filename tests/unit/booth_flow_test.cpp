@@ -168,9 +168,9 @@ TEST(VisitorFlow, WholeSessionKept) {
     EXPECT_EQ(b.screen(), ScreenId::Processing);
     EXPECT_EQ(b.model().progress, 0.0);
 
-    b.send(FitProgress{0.4, "head_fit", at(b.now + 0.5)});
+    b.send(FitProgress{FitStep::HeadFit, at(b.now + 0.5)});
     EXPECT_EQ(b.model().progress, 0.4);
-    EXPECT_EQ(b.model().stage, "head_fit");
+    EXPECT_EQ(b.model().fitStep, FitStep::HeadFit);
     EXPECT_EQ(b.send(FitDone{at(b.now + 0.5)}), Names{kLampsBoth});
     EXPECT_EQ(b.screen(), ScreenId::Reveal);
 

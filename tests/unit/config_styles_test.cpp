@@ -22,11 +22,11 @@ using avatarbooth::test::errorOf;
 TEST(ConfigStyles, ShippedReferenceEqualsTheDefaults) {
     const BoothConfig shipped = loadBoothConfig(std::filesystem::path(AVATARBOOTH_TEST_SOURCE_DIR) / "app/assets/booth.toml");
     const BoothConfig defaults = parseBoothConfig("", "empty.toml");
-    EXPECT_EQ(shipped.fit.settings.characterEnabled, defaults.fit.settings.characterEnabled);
-    EXPECT_DOUBLE_EQ(shipped.fit.settings.character.exaggeration, defaults.fit.settings.character.exaggeration);
-    EXPECT_EQ(shipped.fit.settings.character.sliders, defaults.fit.settings.character.sliders);
-    EXPECT_EQ(shipped.fit.settings.character.coloursFromPhoto, defaults.fit.settings.character.coloursFromPhoto);
-    EXPECT_EQ(shipped.fit.settings.character.textureSize, defaults.fit.settings.character.textureSize);
+    EXPECT_EQ(shipped.character.enabled, defaults.character.enabled);
+    EXPECT_DOUBLE_EQ(shipped.character.settings.exaggeration, defaults.character.settings.exaggeration);
+    EXPECT_EQ(shipped.character.settings.sliders, defaults.character.settings.sliders);
+    EXPECT_EQ(shipped.character.settings.coloursFromPhoto, defaults.character.settings.coloursFromPhoto);
+    EXPECT_EQ(shipped.character.settings.textureSize, defaults.character.settings.textureSize);
     EXPECT_EQ(shipped.reveal.styles, defaults.reveal.styles);
     EXPECT_EQ(shipped.reveal.toonColours, defaults.reveal.toonColours);
     EXPECT_EQ(shipped.reveal.toonStripFrames, defaults.reveal.toonStripFrames);
@@ -38,7 +38,7 @@ TEST(ConfigStyles, ShippedReferenceEqualsTheDefaults) {
     EXPECT_EQ(defaults.reveal.styles,
               (std::vector<AvatarStyle>{AvatarStyle::Photo, AvatarStyle::Character, AvatarStyle::Toon}));
     EXPECT_TRUE(defaults.stage.enabled);
-    EXPECT_FALSE(defaults.fit.settings.character.sliders.has_value());
+    EXPECT_FALSE(defaults.character.settings.sliders.has_value());
 }
 
 TEST(ConfigStyles, ValuesLandInTheirSettings) {
@@ -62,10 +62,10 @@ map = "island.map"
 sweep_s = 8
 low_angle_deg = 20
 )", (dir / "booth.toml").string());
-    EXPECT_DOUBLE_EQ(c.fit.settings.character.exaggeration, 1.4);
-    EXPECT_EQ(c.fit.settings.character.sliders, (std::set<std::string>{"face_aspect", "eye_size"}));
-    EXPECT_FALSE(c.fit.settings.character.coloursFromPhoto);
-    EXPECT_EQ(c.fit.settings.character.textureSize, 256);
+    EXPECT_DOUBLE_EQ(c.character.settings.exaggeration, 1.4);
+    EXPECT_EQ(c.character.settings.sliders, (std::set<std::string>{"face_aspect", "eye_size"}));
+    EXPECT_FALSE(c.character.settings.coloursFromPhoto);
+    EXPECT_EQ(c.character.settings.textureSize, 256);
     EXPECT_EQ(c.reveal.styles, (std::vector<AvatarStyle>{AvatarStyle::Toon, AvatarStyle::Photo}));
     EXPECT_EQ(c.reveal.toonColours, 4);
     EXPECT_EQ(c.reveal.toonStripFrames, 36);
@@ -75,11 +75,11 @@ low_angle_deg = 20
 
     // No sliders: the character keeps the base head's proportions (a set naming none, not "all").
     const BoothConfig none = parseBoothConfig("[character]\nsliders = []\n", "booth.toml");
-    ASSERT_TRUE(none.fit.settings.character.sliders.has_value());
-    EXPECT_TRUE(none.fit.settings.character.sliders->empty());
+    ASSERT_TRUE(none.character.settings.sliders.has_value());
+    EXPECT_TRUE(none.character.settings.sliders->empty());
     // The character switched off leaves the default styles without it.
     const BoothConfig off = parseBoothConfig("[character]\nenabled = false\n", "booth.toml");
-    EXPECT_FALSE(off.fit.settings.characterEnabled);
+    EXPECT_FALSE(off.character.enabled);
     EXPECT_EQ(off.reveal.styles, (std::vector<AvatarStyle>{AvatarStyle::Photo, AvatarStyle::Toon}));
     EXPECT_FALSE(parseBoothConfig("[stage]\nenabled = false\nmap = \"/nonexistent.map\"\n", "b.toml").stage.enabled);
 }

@@ -69,7 +69,7 @@ void expectSameSettings(const BoothConfig& shipped, const BoothConfig& defaults)
     EXPECT_EQ(shipped.fit.settings.head.rbf.kernel, defaults.fit.settings.head.rbf.kernel);
     EXPECT_DOUBLE_EQ(shipped.fit.settings.head.rbf.unitMm, defaults.fit.settings.head.rbf.unitMm);
     EXPECT_EQ(shipped.fit.settings.texture.size, defaults.fit.settings.texture.size);
-    EXPECT_EQ(shipped.fit.settings.previewSize, defaults.fit.settings.previewSize);
+    EXPECT_EQ(shipped.fit.previewSize, defaults.fit.previewSize);
     EXPECT_EQ(shipped.camera.backend, defaults.camera.backend);
     EXPECT_EQ(shipped.camera.previewWidth, defaults.camera.previewWidth);
     EXPECT_EQ(shipped.camera.previewHeight, defaults.camera.previewHeight);

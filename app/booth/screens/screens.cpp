@@ -531,8 +531,8 @@ void ScreenRenderer::processing(const ScreenModel& m) {
     fillRounded(canvas_, bar, bar.height / 2, cv::Scalar(90, 60, 45));
     const int filled = static_cast<int>(std::lround(std::clamp(m.progress, 0.0, 1.0) * bar.width));
     if (filled >= bar.height) fillRounded(canvas_, {bar.x, bar.y, filled, bar.height}, bar.height / 2, kAccent);
-    const std::string key = "stage." + m.stage;
-    const bool known = !m.stage.empty() && strings_.has(settings_.language, key);
+    const std::string key = m.fitStep ? std::string("stage.") + toString(*m.fitStep) : std::string();
+    const bool known = !key.empty() && strings_.has(settings_.language, key);
     const cv::Rect stageBox(L.middle.x, bar.br().y + static_cast<int>(16 * u), L.middle.width,
                             static_cast<int>(70 * u));
     drawText(str(known ? key : "stage.working"), stageBox, static_cast<int>(40 * u), kSoftWhite);

@@ -8,6 +8,7 @@
 #include "booth/session_store.h"
 #include "booth/screens/strings.h"
 #include "booth/screens/text_renderer.h"
+#include "reveal/styles/reveal_styles.h"
 
 #include <opencv2/core.hpp>
 
@@ -45,12 +46,6 @@ struct OperatorInfo {
     int sessionsStored = 0;
     std::uintmax_t freeBytes = 0;
     RetentionReport lastFreed;  // what the last FreeDisk did
-};
-
-// One style of the avatar (reveal and attract show several side by side).
-struct StyledAvatar {
-    std::string style;  // "photo", "character", "toon": its label is the string "style.<style>"
-    cv::Mat image;      // BGR or BGRA; empty: still being made (the place shows "style.making")
 };
 
 struct ScreenInputs {

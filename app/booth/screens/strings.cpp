@@ -40,8 +40,6 @@ constexpr std::string_view kRequired[] = {
     "stage.side_profile",
     "stage.head_fit",
     "stage.texture",
-    "stage.export",
-    "stage.previews",
     "stage.working",
     "reveal.title",
     "reveal.keep",

@@ -23,6 +23,7 @@
 #include "fit/face/profile.h"
 
 #include "common/error.h"
+#include "fit/fit_error.h"
 #include "fit/face/silhouette.h"
 
 #include <opencv2/imgproc.hpp>
@@ -513,51 +514,28 @@ cv::Point2d profilePoint(const std::vector<ProfilePoint>& points, std::string_vi
 
 // ------------------------------------------------------------------------------------------ side photo analysis
 
-namespace {
-
-// OpenCV's frontal-face cascade, loaded once. LBP "improved" is preferred: on the sample photos it is as reliable
-// as the Haar cascade (all 8 frmdb fronts found, none of the 16 profiles) and 4x faster (16 ms vs 70 ms on a 320 px
-// copy on this machine kind). A missing cascade turns the frontal check off with a warning.
-class FrontalFaceCheck {
-public:
-    explicit FrontalFaceCheck(const std::filesystem::path& dir) {
-        const std::filesystem::path candidates[] = {
-            dir.parent_path() / "lbpcascades" / "lbpcascade_frontalface_improved.xml",
-            dir / "lbpcascade_frontalface_improved.xml", dir / "haarcascade_frontalface_alt2.xml"};
-        for (const auto& c : candidates) {
-            std::error_code ec;
-            if (std::filesystem::is_regular_file(c, ec) && cascade_.load(c.string())) {
-                source_ = c.string();
-                break;
-            }
+FrontalFaceCheck::FrontalFaceCheck(const std::filesystem::path& dir) {
+    const std::filesystem::path candidates[] = {
+        dir.parent_path() / "lbpcascades" / "lbpcascade_frontalface_improved.xml",
+        dir / "lbpcascade_frontalface_improved.xml", dir / "haarcascade_frontalface_alt2.xml"};
+    for (const auto& c : candidates) {
+        std::error_code ec;
+        if (std::filesystem::is_regular_file(c, ec) && cascade_.load(c.string())) {
+            source_ = c.string();
+            break;
         }
     }
-    bool available() const { return !source_.empty(); }
-
-    // Frontal faces in a grey image (boxes in its pixels).
-    std::vector<cv::Rect> detect(const cv::Mat& grey, int minSize, int maxSize) {
-        std::lock_guard<std::mutex> lock(mutex_);  // detectMultiScale is not safe to call concurrently
-        std::vector<cv::Rect> faces;
-        // minNeighbors 4: on the frmdb fronts the cascade's merged boxes carry 12-43 raw hits, false hits 1-3.
-        cascade_.detectMultiScale(grey, faces, 1.1, 4, 0, cv::Size(minSize, minSize), cv::Size(maxSize, maxSize));
-        return faces;
-    }
-
-private:
-    std::mutex mutex_;
-    cv::CascadeClassifier cascade_;
-    std::string source_;
-};
-
-FrontalFaceCheck& frontalFaceCheck(const std::filesystem::path& dir) {
-    static std::mutex mutex;
-    static std::vector<std::pair<std::filesystem::path, std::unique_ptr<FrontalFaceCheck>>> cache;
-    std::lock_guard<std::mutex> lock(mutex);
-    for (auto& [d, check] : cache)
-        if (d == dir) return *check;
-    cache.emplace_back(dir, std::make_unique<FrontalFaceCheck>(dir));
-    return *cache.back().second;
 }
+
+std::vector<cv::Rect> FrontalFaceCheck::detect(const cv::Mat& grey, int minSize, int maxSize) {
+    std::lock_guard<std::mutex> lock(mutex_);  // detectMultiScale is not safe to call concurrently
+    std::vector<cv::Rect> faces;
+    // minNeighbors 4: on the frmdb fronts the cascade's merged boxes carry many raw hits, false hits few.
+    cascade_.detectMultiScale(grey, faces, 1.1, 4, 0, cv::Size(minSize, minSize), cv::Size(maxSize, maxSize));
+    return faces;
+}
+
+namespace {
 
 // Looks for a frontal face on the head: the top of the silhouette's box (1.2 box widths tall), scaled to 200 px
 // wide, where a frontal face is 40-200 px. Returns the box in photo pixels, or nothing.
@@ -582,7 +560,7 @@ std::optional<cv::Rect> findFrontalFace(const cv::Mat& bgr, const cv::Mat& mask,
 
 }  // namespace
 
-SideAnalysis analyzeSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate, const SideOptions& options) {
+SideAnalysis analyseSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate, const SideOptions& options) {
     SideAnalysis out;
     out.mask = segmentPerson(bgr, backgroundPlate, {});
     const auto contour = largestOutline(out.mask);
@@ -595,19 +573,21 @@ SideAnalysis analyzeSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate
     if (options.rejectFrontViews) {
         const std::filesystem::path dir =
             options.cascadeDir.empty() ? std::filesystem::path(AVATARBOOTH_DEFAULT_CASCADE_DIR) : options.cascadeDir;
-        FrontalFaceCheck& check = frontalFaceCheck(dir);
+        std::optional<FrontalFaceCheck> loadedHere;
+        if (!options.frontalCheck) loadedHere.emplace(dir);
+        FrontalFaceCheck& check = options.frontalCheck ? *options.frontalCheck : *loadedHere;
         if (!check.available()) {
             out.warnings.push_back("no frontal-face cascade found in " + dir.string() +
                                    ": front views are recognised by their silhouette only");
         } else if (findFrontalFace(bgr, out.mask, check)) {
-            throw BoothError(ErrorKind::Mismatch, "",
-                             "this looks like a front view, not a profile (a frontal face was detected)");
+            throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::NotProfile, "",
+                           "this looks like a front view, not a profile (a frontal face was detected)");
         }
     }
     if (!right.ok && !left.ok)
-        throw BoothError(ErrorKind::Mismatch, "",
-                         "this looks like a front view, not a profile (no nose stands out from either side of the "
-                         "head's outline: " + right.failure + ")");
+        throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::NotProfile, "",
+                       "this looks like a front view, not a profile (no nose stands out from either side of the "
+                       "head's outline: " + right.failure + ")");
 
     const bool useRight = right.ok && (!left.ok || right.noseProminence >= left.noseProminence);
     const ProfileFit& fit = useRight ? right : left;

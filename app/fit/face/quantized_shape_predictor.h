@@ -1,8 +1,7 @@
 // dlib's 68-point shape predictor (an ensemble of regression trees, Kazemi and Sullivan 2014) held with its leaf
-// vectors as 16-bit integers instead of 32-bit floats: the model of Debian's libdlib-data holds 7500 trees of 16
-// leaves of 136 floats, 65 MB in 120,000 small blocks, which was a fifth of the kiosk's peak RSS (issue 3). Stored
-// this way it takes 33 MB in one block; on the shared data's 21 faces 92% of its landmarks are dlib's own and
-// none is more than 2 px away, as close to the hand-placed points (tests/data).
+// vectors as 16-bit integers instead of 32-bit floats, in one block instead of one per leaf: the float model was a
+// large share of the kiosk's peak memory (README, "Memory", has the figures, and tests/data how close its
+// landmarks stay to dlib's own).
 //
 // Only the storage is ours: the model file is read with dlib's deserialisers (its own format, version 1), and the
 // pixel features, the shape-to-image transforms and the tree walk are dlib's (dlib/image_processing/

@@ -1,10 +1,9 @@
 // Person/background segmentation: colour models learned per photo, relabelling with cleaning, edge refinement.
 //
-// Why not GrabCut: on this machine kind (2 cores) cv::grabCut takes 130-180 ms on a 243x136 copy of a booth photo,
-// several times the whole side-photo budget (60 ms). The method here keeps GrabCut's idea (two colour models,
-// re-estimated from the current labels, plus spatial smoothing) with cheaper parts: smoothed colour histograms
-// instead of GMMs, and a Gaussian-smoothed log-likelihood ratio plus "one component without holes" instead of a
-// graph cut. It runs in about 15-25 ms on a 972x544 photo.
+// Why not GrabCut: cv::grabCut takes several times the whole side-photo budget on a small copy of a booth photo
+// on two cores (README, the fit's figures). The method here keeps GrabCut's idea (two colour models, re-estimated
+// from the current labels, plus spatial smoothing) with cheaper parts: smoothed colour histograms instead of GMMs,
+// and a Gaussian-smoothed log-likelihood ratio plus "one component without holes" instead of a graph cut.
 #include "fit/face/silhouette.h"
 
 #include "common/error.h"

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct BaseHead {
 
 // The built-in base head, made by code (see base_head_generator.cpp for how, and how to make another).
 const BaseHead& builtinBaseHead();
+// The same, owned: a holder keeps it alive past the process's static destructors (a thread still loading the
+// landmark model at exit reads it).
+std::shared_ptr<const BaseHead> sharedBuiltinBaseHead();
 
 // Loads an operator's own base head: a glTF binary mesh (positions, UVs, one primitive) and a feature file
 // (JSON, the format written by saveBaseHead). Errors name the file and the field.

@@ -27,6 +27,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include <memory>
+
 namespace avatarbooth {
 namespace {
 
@@ -224,9 +226,11 @@ BaseHead generate() {
 
 }  // namespace
 
-const BaseHead& builtinBaseHead() {
-    static const BaseHead head = generate();
+std::shared_ptr<const BaseHead> sharedBuiltinBaseHead() {
+    static const std::shared_ptr<const BaseHead> head = std::make_shared<const BaseHead>(generate());
     return head;
 }
+
+const BaseHead& builtinBaseHead() { return *sharedBuiltinBaseHead(); }
 
 }  // namespace avatarbooth

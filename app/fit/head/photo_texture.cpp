@@ -250,29 +250,45 @@ inline cv::Vec3b toBgr(const cv::Vec3f& c) {
     return {cv::saturate_cast<unsigned char>(c[0]), cv::saturate_cast<unsigned char>(c[1]), cv::saturate_cast<unsigned char>(c[2])};
 }
 
+int checkedTextureSize(const PhotoTextureOptions& options) {
+    if (options.size < 16) throw BoothError(ErrorKind::Internal, "", "texture: the size must be at least 16 texels");
+    return options.size;
+}
+
+const Mesh& withUvs(const Mesh& mesh) {
+    if (mesh.uvs.size() != mesh.positions.size())
+        throw BoothError(ErrorKind::Internal, "", "texture: the mesh has no texture coordinates");
+    return mesh;
+}
+
 }  // namespace
 
-void prepareTexture(const Mesh& mesh, const PhotoTextureOptions& options) {
-    if (options.size < 16) throw BoothError(ErrorKind::Internal, "", "texture: the size must be at least 16 texels");
-    cachedTexelMap(mesh, cv::Size(options.size, options.size));
-    cachedTexelMap(mesh, cv::Size((options.size + 1) / 2, (options.size + 1) / 2));
-}
+TextureTables::TextureTables(const Mesh& base, const PhotoTextureOptions& options)
+    : vertices_(withUvs(base).uvs.size()), triangles_(base.triangles.size()),
+      full_(mapTexels(base, cv::Size(checkedTextureSize(options), options.size))),
+      half_(mapTexels(base, cv::Size((options.size + 1) / 2, (options.size + 1) / 2))) {}
 
 PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
                                const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options) {
+    return textureFromPhotos(fitted, fit, front, frontMask, side, sideMask, options, TextureTables(fitted, options));
+}
+
+PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
+                               const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options,
+                               const TextureTables& tables) {
     if (front.empty() || side.empty() || front.type() != CV_8UC3 || side.type() != CV_8UC3 || front.cols < 2 ||
         front.rows < 2 || side.cols < 2 || side.rows < 2)
         throw BoothError(ErrorKind::Internal, "", "texture: the photos must be 8-bit BGR");
     if (frontMask.size() != front.size() || sideMask.size() != side.size() || frontMask.type() != CV_8U || sideMask.type() != CV_8U)
         throw BoothError(ErrorKind::Internal, "", "texture: each silhouette must be an 8-bit mask of its photo's size");
-    if (options.size < 16) throw BoothError(ErrorKind::Internal, "", "texture: the size must be at least 16 texels");
-    if (fitted.uvs.size() != fitted.positions.size())
-        throw BoothError(ErrorKind::Internal, "", "texture: the mesh has no texture coordinates");
+    checkedTextureSize(options);
+    withUvs(fitted);
+    if (tables.size() != options.size || !tables.fits(fitted))
+        throw BoothError(ErrorKind::Internal, "", "texture: the texel tables were made for another mesh or size");
     const cv::Size size(options.size, options.size);
     const cv::Size half((size.width + 1) / 2, (size.height + 1) / 2);
-    // Which triangle covers each texel depends only on the UV layout: computed once per base head and size.
-    const TexelMap& map = cachedTexelMap(fitted, size);
-    const TexelMap& halfMap = cachedTexelMap(fitted, half);
+    const TexelMap& map = tables.full();
+    const TexelMap& halfMap = tables.half();
 
     // --- Each vertex in both views, and a z-buffer per camera: front (+z), the side photo's own side (-x), and the
     // other side (+x), which the side photo stands in for, mirrored. Orthographic views make the depth linear.

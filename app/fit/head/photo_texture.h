@@ -4,6 +4,7 @@
 #pragma once
 
 #include "fit/head/head_fit.h"
+#include "fit/head/surface_texels.h"
 
 #include <opencv2/core.hpp>
 
@@ -41,12 +42,31 @@ struct PhotoTexture {
 // head (a z-buffer of the fitted mesh rendered from that photo's orthographic view). The side photo is used for
 // both sides of the head. Texels no photo saw (the back of the head) are filled from their surroundings by a
 // pull-push (coarse-to-fine) fill, so they continue the hair and skin colours around them.
+// What textureFromPhotos needs once per UV layout and texture size: which texel lies in which triangle, at the
+// texture's size and at half of it. Depends only on the UVs, so every fitted head of one base head shares it: a
+// pipeline makes it with its other one-off loading, so that the first visitor's texture does not pay for it.
+class TextureTables {
+public:
+    // Throws BoothError(Internal) for a size under 16 texels.
+    TextureTables(const Mesh& base, const PhotoTextureOptions& options);
+    int size() const { return full_.size.width; }
+    const TexelMap& full() const { return full_; }
+    const TexelMap& half() const { return half_; }
+    // Whether `mesh` has the UV layout the tables were made for (same vertex and triangle counts).
+    bool fits(const Mesh& mesh) const { return mesh.uvs.size() == vertices_ && mesh.triangles.size() == triangles_; }
+
+private:
+    std::size_t vertices_, triangles_;
+    TexelMap full_, half_;
+};
+
+// `tables`: made for the fitted mesh's base head and options.size (BoothError Internal otherwise).
+PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
+                               const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options,
+                               const TextureTables& tables);
+// The same, making the tables for this one call.
 PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
                                const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options = {});
-
-// Computes what textureFromPhotos needs once per UV layout and size (which texel lies in which triangle) ahead of
-// time, so that the first visitor's texture does not pay for it. Meshes of the same topology and UVs share it.
-void prepareTexture(const Mesh& mesh, const PhotoTextureOptions& options = {});
 
 // Fills texels where weight == 0 from the others, coarse to fine (pull-push); texels of partial weight blend
 // with the fill. colour: CV_32FC3, weight: CV_32F (all 1 afterwards).

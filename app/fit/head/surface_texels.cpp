@@ -44,28 +44,6 @@ TexelMap mapTexels(const Mesh& mesh, cv::Size size) {
     return map;
 }
 
-const TexelMap& cachedTexelMap(const Mesh& mesh, cv::Size size) {
-    // Keyed by the UV layout's fingerprint: sizes and a sample of the coordinates.
-    struct Key {
-        int width, height;
-        std::size_t vertices, triangles;
-        double uvSum;
-        bool operator<(const Key& o) const {
-            return std::tie(width, height, vertices, triangles, uvSum) < std::tie(o.width, o.height, o.vertices, o.triangles, o.uvSum);
-        }
-    };
-    double uvSum = 0.0;
-    for (std::size_t i = 0; i < mesh.uvs.size(); i += 7) uvSum += mesh.uvs[i].x * 3.0 + mesh.uvs[i].y;
-    for (std::size_t i = 0; i < mesh.triangles.size(); i += 11) uvSum += mesh.triangles[i].x + 0.5 * mesh.triangles[i].z;
-    const Key key{size.width, size.height, mesh.uvs.size(), mesh.triangles.size(), uvSum};
-    static std::mutex mutex;
-    static std::map<Key, std::unique_ptr<TexelMap>> cache;
-    const std::lock_guard<std::mutex> lock(mutex);
-    auto& slot = cache[key];
-    if (!slot) slot = std::make_unique<TexelMap>(mapTexels(mesh, size));
-    return *slot;
-}
-
 SurfaceTexels sampleSurfaceTexels(const Mesh& mesh, const std::vector<glm::dvec3>& normals, const TexelMap& map) {
     SurfaceTexels out;
     out.position = cv::Mat(map.size, CV_32FC3, cv::Scalar::all(0));

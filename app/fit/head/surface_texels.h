@@ -23,8 +23,6 @@ struct TexelMap {
 };
 
 TexelMap mapTexels(const Mesh& mesh, cv::Size size);
-// The map of mesh's UV layout at this size from a process-wide cache (thread-safe).
-const TexelMap& cachedTexelMap(const Mesh& mesh, cv::Size size);
 // Positions and normals of the mesh at every mapped texel.
 SurfaceTexels sampleSurfaceTexels(const Mesh& mesh, const std::vector<glm::dvec3>& normals, const TexelMap& map);
 

@@ -3,6 +3,8 @@
 
 #include "fit/export/glb.h"
 
+#include <chrono>
+
 namespace avatarbooth {
 
 std::optional<cv::Point2d> earHoleInFrontPhoto(const HeadFit& fit, const std::map<std::string, cv::Point2d>& side) {
@@ -15,6 +17,7 @@ std::optional<cv::Point2d> earHoleInFrontPhoto(const HeadFit& fit, const std::ma
 CharacterOutputs makeCharacterOutputs(const cv::Mat& frontPhoto, const std::array<cv::Point2d, 68>& landmarks,
                                       const cv::Mat& frontMask, std::optional<cv::Point2d> earHole,
                                       const BaseHead& base, const CharacterSettings& settings) {
+    const auto t0 = std::chrono::steady_clock::now();
     NaritaMappingInput input;
     input.landmarks = landmarks;
     input.mask = frontMask;
@@ -51,7 +54,13 @@ CharacterOutputs makeCharacterOutputs(const cv::Mat& frontPhoto, const std::arra
     out.glb = encodeGlb(head.mesh, head.texture, "character");
     out.warnings = mapping.warnings;
     out.head = std::move(head);
+    out.makeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;
+}
+
+CharacterOutputs makeCharacterOutputs(const FitOutcome& o, const BaseHead& base, const CharacterSettings& settings) {
+    return makeCharacterOutputs(o.front, o.frontLandmarks.points, o.frontMask, earHoleInFrontPhoto(o.fit, o.sideLandmarks),
+                                base, settings);
 }
 
 }  // namespace avatarbooth

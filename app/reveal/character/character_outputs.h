@@ -1,8 +1,9 @@
-// What a fit writes for the character maker (issue 6): character.json (Narita's proportions and slider values)
+// What a fit writes for the character maker (Narita): character.json (Narita's proportions and slider values)
 // and character.glb (the stylised character head), made from the fit's front photo analysis.
 #pragma once
 
 #include "reveal/character/character_head.h"
+#include "fit/fit_pipeline.h"
 #include "fit/head/head_fit.h"
 
 #include <opencv2/core.hpp>
@@ -19,6 +20,7 @@ struct CharacterOutputs {
     std::string glb;                    // character.glb bytes
     std::vector<std::string> warnings;  // for fit.json (ears estimated, temples cut by the frame, ...)
     CharacterHead head;                 // the head itself (mesh and painted texture), for the kiosk's reveal
+    double makeSeconds = 0.0;           // how long making it took (fit.json's "character" stage)
 };
 
 // The side photo's ear hole carried into the front photo through the fit's shared heights (its x is the head's
@@ -30,5 +32,8 @@ std::optional<cv::Point2d> earHoleInFrontPhoto(const HeadFit& fit, const std::ma
 CharacterOutputs makeCharacterOutputs(const cv::Mat& frontPhoto, const std::array<cv::Point2d, 68>& landmarks,
                                       const cv::Mat& frontMask, std::optional<cv::Point2d> earHole,
                                       const BaseHead& base, const CharacterSettings& settings = {});
+// The same from a fit (its front photo, landmarks and silhouette, and the side photo's ear hole).
+CharacterOutputs makeCharacterOutputs(const FitOutcome& outcome, const BaseHead& base,
+                                      const CharacterSettings& settings = {});
 
 }  // namespace avatarbooth

@@ -1,89 +1,83 @@
-// The avatar styles besides the photo-fitted head on the reveal and attract screens — the character (issue 6) and
-// the two-view toon (issue 7) — and the tile stage under them, as the kiosk's main loop uses them.
+// The avatar styles shown side by side on the reveal and attract screens ([reveal] styles: RevealStyle each), the
+// head motion they all turn with, and the tile stage under them, as the kiosk's main loop uses them.
 //
-// The kiosk hands each finished fit to visitor(), and the character head to visitorCharacter() when the fitter has
-// made it (a moment later: the reveal does not wait for it); the toon is drawn from the two photos on a
-// worker thread of its own so the screen never waits. Each frame, fill() adds the styles' images (and the stage) to
-// the screen's inputs; every image is kept and reused while the animation holds a pose or the stage camera holds
-// its angle.
+// The kiosk hands each finished fit to visitor() (and runs the work it returns off the screen's thread), and the
+// character to visitorCharacter() when the fitter has made it. Each frame, fill() hands out every style's picture
+// at the size it is shown, and the stage; every picture is kept and reused while the animation holds a pose or the
+// stage camera holds its angle.
 #pragma once
 
-#include "reveal/animation/avatar_motion.h"
-#include "fit/head/base_head.h"
-#include "fit/head/mesh.h"
+#include "reveal/styles/photo_style.h"
+#include "reveal/styles/reveal_style.h"
 #include "reveal/styles/style_settings.h"
-#include "booth/screens/screens.h"
 
 #include <opencv2/core.hpp>
 
-#include <array>
 #include <chrono>
 #include <filesystem>
-#include <map>
 #include <memory>
-#include <optional>
 #include <string>
+#include <vector>
 
 namespace avatarbooth {
 
-struct FitOutcome;
+struct BaseHead;
 class HeadlessEglContext;
 
-// What the toon needs of one fit: the photos with their head masks.
-struct StyleInputs {
-    cv::Mat front, frontMask, side, sideMask;
-    bool sideNoseImageRight = true;
-    int sideChinRow = -1;  // the side photo's chin row: both masks are cut there (head only); -1: not cut
-    // The fit's landmarks (optional): the toon draws the eyes, brows, nostrils and mouth as regions of their own.
-    std::optional<std::array<cv::Point2d, 68>> frontLandmarks;
-    std::map<std::string, cv::Point2d> sideLandmarks;
+// One style's picture (reveal and attract show several side by side).
+struct StyledAvatar {
+    std::string style;  // "photo", "character", "toon": its label is the string "style.<style>"
+    cv::Mat image;      // BGR or BGRA; empty: still being made (the place shows "style.making")
 };
-// Takes what the styles need from a fit (the photos and masks are shared, not copied).
-StyleInputs styleInputsFrom(const FitOutcome& outcome);
 
-// Per-style cost of the last frames, for the benchmark figures (milliseconds, medians over the frames that drew).
-struct StyleFigures {
-    double characterMs = 0.0, toonMs = 0.0, stageMs = 0.0;
-    double toonBuildSeconds = 0.0;  // the last toon drawn from photos
-    int stageRenders = 0, characterRenders = 0, toonRenders = 0, frames = 0;
+// What fill() hands the screen: the styles in order of importance, and the stage band.
+struct StyleImages {
+    std::vector<StyledAvatar> avatars;
+    cv::Mat stage;  // BGRA, at half the band's resolution; empty without a stage
 };
+
+// The styles a configuration lists, in its order, made by name (the one place that knows every style).
+std::vector<std::unique_ptr<RevealStyle>> makeRevealStyles(const RevealSettings& reveal, const BaseHead& base,
+                                                           HeadlessEglContext* context, PhotoStyleOptions photo = {});
 
 class RevealStyles {
 public:
-    // `base` shows as the character (painted, neutral proportions) before the first visitor. Throws BoothError
-    // (BadConfig) when the stage map cannot be read or parsed (file:line:column).
-    // `context`: the GL context the character and the stage render through (the kiosk's one offscreen context for
-    // its main thread; it must outlive this); their own when null.
+    // `base` shows before the first visitor. Throws BoothError (BadConfig) when the stage map cannot be read or
+    // parsed (file:line:column). `context`: the GL context the styles and the stage render through (the kiosk's
+    // one offscreen context for its main thread; it must outlive this); their own when null.
     RevealStyles(const RevealSettings& reveal, const StageSettings& stage, const AnimationSettings& animation,
-                 const BaseHead& base, int avatarSize, HeadlessEglContext* context = nullptr);
+                 const BaseHead& base, HeadlessEglContext* context = nullptr, PhotoStyleOptions photo = {});
     ~RevealStyles();
 
-    // A new visitor's fit: starts drawing their toon (an earlier toon still being drawn is dropped); their character
-    // is awaited (its place says so on the reveal; never the previous visitor's).
-    void visitor(StyleInputs inputs);
-    // The current visitor's character head, once made; or none (its making or the session's write failed): the
-    // character's place is then left out.
-    void visitorCharacter(const Mesh& mesh, const cv::Mat& texture);
-    void visitorWithoutCharacter();
-    // Changes whenever an image fill() hands out changes (a new render, a style appearing or going); for the screen,
-    // which does not compose an unchanged reveal again.
+    // A new visitor's fit: each style drops the last visitor's picture and starts on this one's. Returns the work
+    // to run off the screen's thread, in order; what it posts is run on the screen's thread.
+    std::vector<StyleWork> visitor(const FitOutcome& fit);
+    // The current visitor's character, once made; null when none comes (its making failed or it is off).
+    void visitorCharacter(const CharacterOutputs* character);
+
+    // Every style's picture in order, each `sizes[i]` pixels square (the size its place is shown at; the last size
+    // for the rest), and the stage for a band of `stageBand` pixels (none when empty), for the reveal (`reveal`)
+    // or attract screen `since` it was entered. A style without a picture has an empty place on the reveal while
+    // it is being made, and no place otherwise.
+    void fill(StyleImages& out, bool reveal, std::chrono::milliseconds since, const std::vector<int>& sizes,
+              cv::Size stageBand);
+    // Changes whenever a picture fill() hands out changes (a new render, a style appearing or going); for the
+    // screen, which does not compose an unchanged reveal again.
     std::uint64_t version() const;
-
-    // Adds to `in` the image of every configured style in order (the photo style is `in.avatar`, which the kiosk
-    // rendered) and the stage, for the reveal (`reveal`) or attract screen `since` it was entered.
-    void fill(ScreenInputs& in, bool reveal, std::chrono::milliseconds since, const ScreenLayout& layout);
-
-    // The visitor's character is still being made (it comes, or visitorWithoutCharacter() says it will not).
-    bool characterPending() const;
-    // Whether the toon style is on (drawn for every visitor).
-    bool showsToon() const;
-    // Whether the last fill() had an image for every style it listed (the toon may still be drawing).
+    // Whether the last fill() had a picture for every style it listed (the toon may still be drawing).
     bool complete() const { return complete_; }
-    // No toon is being drawn for the current visitor (drawn, failed, or none asked for).
-    bool toonSettled() const;
-    // Writes the current visitor's toon turntable strip into `sessionFolder`/toon (atomically) when there is one.
-    // Returns whether it wrote.
-    bool writeToonStrip(const std::filesystem::path& sessionFolder);
+    // A picture that comes for sure and soon (the character) is still awaited.
+    bool awaitingSoon() const;
+    // No style's work is running for the current visitor.
+    bool settled() const;
+    // Whether a kept session gets extras of some style (the toon strip).
+    bool hasExtras() const;
+    // Writes every style's extras for a kept session (the toon strip). Returns whether any wrote.
+    bool writeInto(const std::filesystem::path& keptSession);
+    // Whether the last fill() had the photo style's picture.
+    bool photoShown() const { return photoShown_; }
+    std::size_t photoTriangles() const;
+    int photoSamples() const;
 
     StyleFigures figures() const;
 
@@ -91,6 +85,7 @@ private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
     bool complete_ = true;
+    bool photoShown_ = false;
 };
 
 }  // namespace avatarbooth

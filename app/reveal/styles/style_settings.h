@@ -10,7 +10,7 @@
 namespace avatarbooth {
 
 // The ways the visitor's head is shown: the photo-fitted head (NTT), the character made from the base head with the
-// visitor's proportions (Narita, issue 6), and the two-view billboard toon drawn from the photos (Kitamura, issue 7).
+// visitor's proportions (Narita), and the two-view billboard toon drawn from the photos (Kitamura).
 enum class AvatarStyle { Photo, Character, Toon };
 
 inline const char* toString(AvatarStyle s) {

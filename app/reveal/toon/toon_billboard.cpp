@@ -364,7 +364,7 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
 }
 ToonModel toonFromPhotoPair(const cv::Mat& frontBgr, const cv::Mat& sideBgr, const cv::Mat& plate, int colours,
                             const std::optional<std::array<cv::Point2d, 68>>& frontLandmarks) {
-    const SideAnalysis profile = analyzeSidePhoto(sideBgr, plate);
+    const SideAnalysis profile = analyseSidePhoto(sideBgr, plate);
     // Both photos come from the same camera at the same height: the side photo's chin row cuts both masks to the head.
     const int chin = static_cast<int>(profilePoint(profile.landmarks, "chin").y) + 1;
     cv::Mat frontMask = segmentPerson(frontBgr, plate), sideMask = profile.mask.clone();

@@ -70,7 +70,7 @@ ToonModel toonFromPhotos(const cv::Mat& frontBgr, const cv::Mat& frontMask, cons
                          int headHeightPx = 320, const ToonLandmarks& landmarks = {});
 
 // The whole recipe from two photos (what `avatarbooth toon` and the kiosk use): the person's silhouette in each photo
-// (segmentPerson; the side one from analyzeSidePhoto, which also says which way it faces), both cut at the side
+// (segmentPerson; the side one from analyseSidePhoto, which also says which way it faces), both cut at the side
 // photo's chin row (same camera, same height) so the masks hold the head, then toonFromPhotos. `plate` (the empty
 // booth, optional) improves the silhouettes. Throws BoothError(NoFace) when the side profile or a mask is missing.
 // `frontLandmarks` (dlib's 68 points of the front photo, optional) guide the drawing with the side's profile points.

@@ -1,7 +1,7 @@
-// The kiosk's avatar stage: pose from the motion clip, a render only when the pose changes.
-#include "reveal/styles/avatar_stage.h"
+// The photo style (see photo_style.h).
+#include "reveal/styles/photo_style.h"
 
-#include <chrono>
+#include "fit/fit_pipeline.h"
 
 namespace avatarbooth {
 
@@ -22,37 +22,33 @@ void headFraming(const Mesh& mesh, glm::dvec3& centre, double& extent) {
     extent = glm::length(hi - lo);
 }
 
-AvatarStage::AvatarStage(const AnimationSettings& animation, AvatarStageOptions options, HeadlessEglContext* context)
+PhotoStyle::PhotoStyle(const Mesh& base, PhotoStyleOptions options, HeadlessEglContext* context)
     : renderer_(context ? std::make_unique<MeshRenderer>(
                               *context, MeshRenderer::Options{options.samples, false, options.maxTextureSize})
                         : std::make_unique<MeshRenderer>(
-                              MeshRenderer::Options{options.samples, false, options.maxTextureSize})),
-      reveal_(playAnimation(revealMotion(), animation)),
-      attract_(playAnimation(attractMotion(), animation)),
-      fps_(animation.fps) {}
+                              MeshRenderer::Options{options.samples, false, options.maxTextureSize})) {
+    show(base, cv::Mat(8, 8, CV_8UC3, cv::Scalar(150, 170, 210)));  // skin-coloured, untextured
+}
 
-void AvatarStage::show(const Mesh& mesh, const cv::Mat& texture) {
+StyleWork PhotoStyle::visitor(std::uint64_t, const FitOutcome& fit) {
+    show(fit.fit.mesh, fit.texture.texture);
+    return {};
+}
+
+void PhotoStyle::show(const Mesh& mesh, const cv::Mat& texture) {
     renderer_->upload(mesh, texture);
     headFraming(mesh, centre_, extent_);
-    loaded_ = true;
     ++uploads_;
 }
 
-const cv::Mat& AvatarStage::frame(bool reveal, Millis since, int size) {
+const cv::Mat& PhotoStyle::frame(const AnimationFrame& pose, bool reveal, int size) {
     static const cv::Mat kNone;
-    const auto& clip = reveal ? reveal_ : attract_;
-    if (!loaded_ || clip.empty() || size <= 0) return kNone;
-    const auto index =
-        static_cast<std::size_t>(std::chrono::duration<double>(since).count() * fps_) % clip.size();
-    const AnimationFrame& pose = clip[index];
+    if (size <= 0) return kNone;
     const Key key{reveal, pose.sourceFrame, size, uploads_};
     if (key == shown_ && !image_.empty()) return image_;  // a held pose: the picture has not changed
-
-    const auto t0 = std::chrono::steady_clock::now();
     renderer_->renderBgra(turningHeadCamera(pose.headModel, centre_, extent_, size), image_);
     shown_ = key;
     ++version_;
-    lastRenderSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return image_;
 }
 

@@ -1,0 +1,132 @@
+// Writing the session folder: avatar.glb, the photos, overlays, previews, landmarks.json, the character, fit.json.
+#include "booth/session_folder.h"
+
+#include "common/atomic_output.h"
+#include "common/file_bytes.h"
+#include "common/image_io.h"
+#include "common/landmark_names.h"
+#include "fit/export/glb.h"
+#include "render/mesh_renderer.h"
+#include "render/previews.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+
+namespace avatarbooth {
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string photoExtension(const fs::path& p) {
+    std::string ext = p.extension().string();
+    for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext == ".jpeg" ? ".jpg" : (ext.empty() ? ".jpg" : ext);
+}
+
+nlohmann::json landmarksJson(const FitOutcome& o) {
+    nlohmann::json landmarks;
+    landmarks["pixel_convention"] = "pixel centres at integer coordinates";
+    for (int k = 0; k < 68; ++k) {
+        const auto& p = o.frontLandmarks.points[static_cast<std::size_t>(k)];
+        landmarks["front"][landmarkName(k)] = {p.x, p.y};
+    }
+    landmarks["front_face_box"] = {o.frontLandmarks.face.x, o.frontLandmarks.face.y, o.frontLandmarks.face.width,
+                                   o.frontLandmarks.face.height};
+    for (const auto& [name, p] : o.sideLandmarks) landmarks["side"][name] = {p.x, p.y};
+    landmarks["side_nose_points"] = o.sideNoseImageRight ? "image-right" : "image-left";
+    landmarks["units_3d"] = "millimetres; y up, face along +z, x to the subject's left, origin between the ear holes";
+    for (const auto& [name, p] : o.featurePoints) landmarks["points_3d"][name] = {p.x, p.y, p.z};
+    return landmarks;
+}
+
+// fit.json: what went in, how the fit went (residuals, scales, each stage's time) and its warnings.
+nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& contents,
+                         const std::vector<std::pair<std::string, double>>& writeStages) {
+    nlohmann::json report;
+    report["version"] = AVATARBOOTH_VERSION;
+    const FitPhotoFiles& in = contents.photoFiles;
+    report["inputs"] = {{"front", in.front.string()}, {"side", in.side.string()}, {"background", in.background.string()}};
+    report["rbf"] = {{"kernel", rbfKernelName(o.rbf.kernel)}, {"unit_mm", o.rbf.unitMm},
+                     {"gaussian_sigma", o.rbf.gaussianSigma}, {"regularisation", o.rbf.regularisation}};
+    report["axis_scale"] = {o.fit.axisScale.x, o.fit.axisScale.y, o.fit.axisScale.z};
+    report["mm_per_pixel"] = {{"front", o.fit.front.mmPerPixel}, {"side", o.fit.side.mmPerPixel}};
+    report["texture_seen_fraction"] = o.texture.seenFraction;
+    report["model_load_seconds"] = o.modelLoadSeconds;
+    nlohmann::json stages = nlohmann::json::array();
+    double total = 0.0;
+    for (const auto& [name, seconds] : o.stageSeconds) {
+        stages.push_back({{"stage", name}, {"seconds", seconds}});
+        total += seconds;
+    }
+    for (const auto& [name, seconds] : writeStages) stages.push_back({{"stage", name}, {"seconds", seconds}});
+    report["stages"] = stages;
+    report["fit_seconds"] = total;
+    nlohmann::json residuals = nlohmann::json::array();
+    double worst = 0.0, sum = 0.0;
+    for (const auto& r : o.fit.residuals) {
+        residuals.push_back({{"name", r.name}, {"view", r.view}, {"measured_mm", {r.measured.x, r.measured.y}},
+                             {"fitted_mm", {r.fitted.x, r.fitted.y}}, {"error_mm", r.errorMm}});
+        worst = std::max(worst, r.errorMm);
+        sum += r.errorMm * r.errorMm;
+    }
+    report["residuals"] = residuals;
+    report["residual_rms_mm"] = o.fit.residuals.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(o.fit.residuals.size()));
+    report["residual_max_mm"] = worst;
+    report["warnings"] = o.warnings;
+    if (contents.character)
+        for (const auto& w : contents.character->warnings) report["warnings"].push_back("character: " + w);
+    return report;
+}
+
+}  // namespace
+
+std::vector<fs::path> writeSessionFolder(const FitOutcome& o, const SessionFolderContents& contents,
+                                         const fs::path& folder, MeshRenderer& renderer) {
+    StagedDirectory dir(folder, "fit.json");
+    const fs::path s = dir.staging();
+    std::vector<fs::path> written;
+    const auto put = [&](const std::string& name, const std::string& bytes) {
+        writeFileAtomically(s / name, bytes);
+        written.push_back(folder / name);
+    };
+    const auto photo = [&](const char* name, const fs::path& file, const cv::Mat& image) {
+        put(name + photoExtension(file), file.empty() ? encodeImage(image, ".jpg") : readFileBytes(file));
+    };
+    const auto t0 = Clock::now();
+    put("avatar.glb", encodeGlb(o.fit.mesh, o.texture.texture, "avatar"));
+    // The photos themselves, as taken (personal data: the files are readable by the booth's user only).
+    photo("front", contents.photoFiles.front, o.front);
+    photo("side", contents.photoFiles.side, o.side);
+    put("front_overlay.jpg", encodeImage(drawFrontOverlay(o), ".jpg"));
+    put("side_overlay.jpg", encodeImage(drawSideOverlayWithRays(o), ".jpg"));
+    const double exportSeconds = secondsSince(t0);
+
+    const auto t1 = Clock::now();
+    renderer.upload(o.fit.mesh, o.texture.texture);
+    const PreviewSet previews = renderPreviews(renderer, o.fit.mesh, contents.previewSize);
+    put("preview_front.png", encodeImage(previews.front, ".png"));
+    put("preview_side.png", encodeImage(previews.side, ".png"));
+    put("preview_three_quarter.png", encodeImage(previews.threeQuarter, ".png"));
+    const double previewSeconds = secondsSince(t1);
+
+    put("landmarks.json", landmarksJson(o).dump(2) + "\n");
+    if (contents.character) {
+        put("character.json", contents.character->json);
+        put("character.glb", contents.character->glb);
+    }
+    const double characterSeconds = contents.character ? contents.character->makeSeconds : 0.0;
+    // fit.json last: its presence marks a complete result.
+    const std::vector<std::pair<std::string, double>> writeStages{
+        {"export", exportSeconds}, {"previews", previewSeconds}, {"character", characterSeconds}};
+    put("fit.json", fitReport(o, contents, writeStages).dump(2) + "\n");
+    dir.commit();
+    return written;
+}
+
+}  // namespace avatarbooth

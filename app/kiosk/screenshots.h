@@ -1,0 +1,37 @@
+// A PNG of every screen the visitor saw (`avatarbooth run --screenshots DIR`), each taken once the screen shows
+// what it is for: the preview on a guide, every style on the reveal, the code on the thanks screen.
+#pragma once
+
+#include "booth/flow_types.h"
+
+#include <opencv2/core.hpp>
+
+#include <filesystem>
+#include <vector>
+
+namespace avatarbooth {
+
+class Screenshots {
+public:
+    // Nothing is written when `dir` is empty.
+    explicit Screenshots(std::filesystem::path dir);
+
+    // Called every frame with the screen drawn. `complete`: the screen has what it is pictured for; `everything`:
+    // it also has what may come later (a guide's first hint, the toon): a picture taken without it is taken again,
+    // under the same name, once it has.
+    void frame(const ScreenModel& screen, const cv::Mat& drawn, bool complete, bool everything);
+    const std::vector<std::filesystem::path>& written() const { return written_; }
+
+private:
+    void write(int index, const ScreenModel& screen, const cv::Mat& drawn, bool replace);
+
+    std::filesystem::path dir_;
+    std::vector<std::filesystem::path> written_;
+    bool due_;
+    int next_ = 0;
+    int provisional_ = -1;  // the index of a picture to take again
+    ScreenId lastScreen_ = ScreenId::Attract;
+    OperatorPage lastMenuPage_ = OperatorPage::Menu;
+};
+
+}  // namespace avatarbooth
