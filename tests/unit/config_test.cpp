@@ -6,6 +6,9 @@
 #include "config/booth_config.h"
 #include "config/config_schema.h"
 #include "common/error.h"
+#include "drivers/camera/camera_backends.h"
+#include "drivers/display/display_backends.h"
+#include "drivers/gpio/button_backends.h"
 
 #include "config_error_of.h"
 
@@ -336,6 +339,31 @@ TEST(Config, MistakesNameFileLineAndKey) {
 }
 
 // More broken files, one per kind of check the schema drives: the line named is the offending value's.
+// The words a backend key allows are the device kind's table's names after "auto", nothing written twice.
+TEST(Config, BackendWordsComeFromTheBackendTables) {
+    const auto quotedList = [](const std::vector<std::string>& words) {
+        std::string s;
+        for (std::size_t i = 0; i < words.size(); ++i)
+            s += (i ? (i + 1 == words.size() ? " or \"" : ", \"") : "\"") + words[i] + "\"";
+        return s;
+    };
+    EXPECT_EQ(errorOf("[camera]\nbackend = \"webcam\"\n"),
+              "booth.toml:2: camera.backend: \"webcam\" is not one of " + quotedList(backendWords(cameraBackends())));
+    EXPECT_EQ(errorOf("[buttons]\nbackend = \"wiringpi\"\n"),
+              "booth.toml:2: buttons.backend: \"wiringpi\" is not one of " + quotedList(backendWords(buttonBackends())));
+    EXPECT_EQ(errorOf("[display]\nbackend = \"fbdev\"\n"),
+              "booth.toml:2: display.backend: \"fbdev\" is not one of " + quotedList(backendWords(displayBackends())));
+    EXPECT_EQ(errorOf("[display]\nbackend = \"fbdev\"\n"),
+              "booth.toml:2: display.backend: \"fbdev\" is not one of \"auto\", \"kms\", \"window\" or \"headless\"");
+    for (const ConfigKey& k : configKeys()) {
+        if (k.name != "backend") continue;
+        const std::vector<std::string> table = k.table == "camera"    ? backendWords(cameraBackends())
+                                               : k.table == "buttons" ? backendWords(buttonBackends())
+                                                                      : backendWords(displayBackends());
+        EXPECT_EQ(k.choices, table) << k.table;
+    }
+}
+
 TEST(Config, BrokenFilesNameFileLineAndKey) {
     // Wrong types.
     EXPECT_EQ(errorOf("[camera]\nsim_real_time = \"yes\"\n"), "booth.toml:2: camera.sim_real_time: expected true or false");
