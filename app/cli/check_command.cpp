@@ -88,6 +88,8 @@ BoothConfig checkConfig(const std::string& given, Report& report) {
         BoothConfig config = loadBoothConfig(file);
         report.ok("config", file.string() + " is valid");
         return config;
+    } catch (const ConfigErrors& e) {
+        for (const BoothError& mistake : e.mistakes()) report.fail("config", mistake.what(), ErrorKind::BadConfig);
     } catch (const BoothError& e) {
         report.fail("config", e.what(), ErrorKind::BadConfig);
     }
