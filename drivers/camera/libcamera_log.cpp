@@ -88,6 +88,8 @@ LibcameraLogLine parseLibcameraLogLine(std::string_view line) {
 void routeLibcameraLogToSpdlog() {
     static std::once_flag once;
     std::call_once(once, [] {
+        // An operator who sent libcamera's log to a file (or syslog) for debugging keeps it there.
+        if (const char* file = std::getenv("LIBCAMERA_LOG_FILE"); file != nullptr && *file != '\0') return;
         const char* asked = std::getenv("LIBCAMERA_LOG_LEVELS");
         // Leaked on purpose: libcamera's logger is a static destroyed at exit in an order we do not control, and
         // must never find its stream gone.

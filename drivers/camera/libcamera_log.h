@@ -21,7 +21,8 @@ LibcameraLogLine parseLibcameraLogLine(std::string_view line);
 
 // From now on libcamera logs into spdlog: WARN and above as spdlog warnings (ERROR, FATAL as errors), lower ones
 // dropped unless LIBCAMERA_LOG_LEVELS asks libcamera for them (then at spdlog's info and debug, seen with -v).
-// Call before the first CameraManager; repeated calls do nothing.
+// With LIBCAMERA_LOG_FILE set libcamera's log stays where that sends it. Call before the first CameraManager;
+// repeated calls do nothing.
 void routeLibcameraLogToSpdlog();
 
 }  // namespace avatarbooth
