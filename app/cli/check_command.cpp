@@ -1,16 +1,20 @@
 // `avatarbooth check [--config FILE] [--json]`: the hardware and set-up self-test an operator runs first.
 //
 // One line per thing the booth needs: OK, WARN (works, but not as a booth would on real hardware: "auto" falls back
-// to a simulation) or FAIL (what the configuration asks for is missing). Nothing is taken: cameras are listed, GPIO
-// lines looked up but not requested, the screen probed without keeping it, so check can run next to a running
-// booth. The exit code is non-zero when anything FAILs (the code of the first failure's kind, see exit_codes.h).
+// to a simulation) or FAIL (what the configuration asks for is missing). Cameras, buttons and the display get one
+// line per backend of their table (drivers/*/..._backends.h) with its probe's result, and a last line with what
+// the configured backend (or "auto", walking the same table as the booth) comes to. Nothing is taken: cameras are
+// listed, GPIO lines looked up but not requested, the screen probed without keeping it, so check can run next to a
+// running booth. The exit code is non-zero when anything FAILs (the code of the first failure's kind, see exit_codes.h).
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
 
 #include "common/error.h"
 #include "config/booth_config.h"
+#include "common/backend_table.h"
 #include "drivers/camera/camera_factory.h"
-#include "drivers/display/kms_display.h"
+#include "drivers/display/display_backends.h"
+#include "drivers/gpio/button_backends.h"
 #include "drivers/gpio/gpiod_lines.h"
 #include "fit/face/landmarks68.h"
 #include "booth/screens/strings.h"
@@ -26,6 +30,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -83,51 +88,75 @@ BoothConfig checkConfig(const std::string& given, Report& report) {
         BoothConfig config = loadBoothConfig(file);
         report.ok("config", file.string() + " is valid");
         return config;
+    } catch (const ConfigErrors& e) {
+        for (const BoothError& mistake : e.mistakes()) report.fail("config", mistake.what(), ErrorKind::BadConfig);
     } catch (const BoothError& e) {
         report.fail("config", e.what(), ErrorKind::BadConfig);
     }
     return BoothConfig{};
 }
 
+// Each backend of a kind's table with its probe's result, then what the configuration comes to (the last line). A
+// failed probe is FAIL when the configuration names that backend, and otherwise information only (the booth does
+// not need it). For "auto" the last line names the backend it takes, the same walk as at start-up: WARN when that is
+// the simulation at the table's end (`simulation` says what the booth would then run). Returns the backend the
+// booth would use, or null when the one named cannot be used.
+template <typename Entry, typename Settings>
+const Entry* checkBackends(const std::string& what, const std::string& key, std::span<const Entry> table,
+                           const Settings& settings, const std::string& simulation, Report& report) {
+    const std::string& configured = settings.backend;
+    const auto line = [&](std::size_t i, const BackendProbe& probe) {
+        const std::string name(table[i].name);
+        if (probe.usable) report.ok(what, name + ": " + probe.text);
+        else if (name == configured)
+            report.fail(what, name + ": " + probe.text + " (" + key + " = \"" + name + "\")", ErrorKind::Device);
+        else report.ok(what, name + ": not usable here: " + probe.text);
+    };
+    if (configured != "auto") {
+        const Entry* named = findBackend(table, configured);
+        for (std::size_t i = 0; i < table.size(); ++i)
+            if (&table[i] != named) line(i, table[i].probe(settings));
+        if (!named) {
+            report.fail(what, "\"" + configured + "\" is not a backend (" + backendWordList(table) + ")", ErrorKind::BadConfig);
+            return nullptr;
+        }
+        const BackendProbe probe = named->probe(settings);
+        line(static_cast<std::size_t>(named - table.data()), probe);
+        return probe.usable ? named : nullptr;
+    }
+    const BackendChoice<Entry> choice = probeBackends(table, settings);
+    for (std::size_t i = 0; i < choice.passed.size(); ++i) line(i, {false, choice.passed[i].why, ""});
+    if (!choice.backend) {
+        report.fail(what, "auto: no backend is usable", ErrorKind::Device);
+        return nullptr;
+    }
+    const auto chosen = static_cast<std::size_t>(choice.backend - table.data());
+    line(chosen, choice.probe);
+    for (std::size_t i = chosen + 1; i < table.size(); ++i) line(i, table[i].probe(settings));
+    const std::string name(choice.backend->name);
+    const std::string why = autoWhy(choice);
+    const std::string because = why.empty() ? std::string() : " (" + why + ")";
+    if (chosen + 1 == table.size()) report.warn(what, "auto: the booth would run " + simulation + because);
+    else report.ok(what, "auto: " + name + because);
+    return choice.backend;
+}
+
 void checkCameras(const CameraSettings& settings, Report& report) {
-    const std::vector<CameraListEntry> cameras = listCameras();
-    for (const auto& c : cameras) {
+    for (const auto& c : listCameras()) {
         const std::string line = c.backend + " " + c.device + ": " + c.name + "; " + c.formats;
         if (c.usable) report.ok("camera", line);
         else report.warn("camera", line + " (not usable)");
     }
-    const bool anyUsable = std::any_of(cameras.begin(), cameras.end(), [](const auto& c) { return c.usable; });
-    if (settings.backend == "sim") {
-        if (!settings.simFolder.empty() && !fs::is_directory(settings.simFolder))
-            report.fail("camera", "sim: camera.sim_folder " + settings.simFolder + " is not a folder", ErrorKind::BadConfig);
-        else
-            report.ok("camera", "sim: the simulated camera (" +
-                                    (settings.simFolder.empty() ? std::string("the synthetic visitor") : settings.simFolder) + ")" +
-                                    (cameras.empty() ? "; no V4L2 or libcamera camera found" : ""));
-        return;
-    }
-    if (settings.backend == "auto") {
-        if (!anyUsable) report.warn("camera", "none found: the booth would run the simulated camera");
-        return;
-    }
-    // An explicit backend: a camera of that kind (and the configured device, when one is named) must be there.
-    bool found = false;
-    for (const auto& c : cameras)
-        if (c.backend == settings.backend && c.usable && (settings.device.empty() || c.device == settings.device))
-            found = true;
-    if (found) return;
-    report.fail("camera",
-                settings.backend + (settings.device.empty() ? std::string(": none found") : ": " + settings.device + " not found") +
-                    " (camera.backend = \"" + settings.backend + "\")",
-                ErrorKind::Device);
+    const CameraBackend* used =
+        checkBackends("camera", "camera.backend", cameraBackends(), settings, "the simulated camera", report);
+    if (used && used->name == "sim" && !settings.simFolder.empty() && !fs::is_directory(settings.simFolder))
+        report.fail("camera", "sim: camera.sim_folder " + settings.simFolder + " is not a folder", ErrorKind::BadConfig);
 }
 
 void checkGpio(const GpioSettings& settings, Report& report) {
-    if (settings.backend == "sim") {
-        report.ok("gpio", "sim: scripted buttons" + (settings.timeline.empty() ? std::string() : " from " + settings.timeline) +
-                              " and keyboard keys");
-        return;
-    }
+    const ButtonBackend* used =
+        checkBackends("gpio", "buttons.backend", buttonBackends(), settings, "simulated buttons", report);
+    if (!used || used->name != "gpiod") return;
     std::vector<unsigned> offsets;
     std::vector<std::string> labels;
     for (const auto& b : settings.buttons) {
@@ -143,9 +172,7 @@ void checkGpio(const GpioSettings& settings, Report& report) {
     try {
         lines = gpiodLineStatus(settings.chip, offsets, &chipName);
     } catch (const BoothError& e) {
-        // The error already lists the chips that exist.
-        if (settings.backend == "auto") report.warn("gpio", std::string(e.what()) + ": the booth would run simulated buttons");
-        else report.fail("gpio", e.what(), ErrorKind::Device);
+        report.fail("gpio", e.what(), ErrorKind::Device);  // the chip went away since the probe
         return;
     }
     report.ok("gpio", "chip " + chipName);
@@ -180,24 +207,7 @@ std::string drmConnectors() {
 
 void checkDisplay(const DisplaySettings& settings, Report& report) {
     if (settings.backend != "headless") report.ok("display", "DRM connectors: " + drmConnectors());
-    if (settings.backend == "headless") {
-        report.ok("display", "headless " + std::to_string(settings.width) + "x" + std::to_string(settings.height) + " (no screen)");
-        return;
-    }
-    if (settings.backend == "window") {
-        const char* d = std::getenv("DISPLAY");
-        if (d && *d) report.ok("display", std::string("window on X display ") + d);
-        else report.fail("display", "window: $DISPLAY is not set", ErrorKind::Device);
-        return;
-    }
-    std::string why;
-    if (kmsScreenAvailable(settings.drmDevice, settings.connector, &why)) {
-        report.ok("display", "kms: a connected screen" + (settings.drmDevice.empty() ? std::string() : " on " + settings.drmDevice) +
-                                 (settings.connector.empty() ? std::string() : " at " + settings.connector));
-        return;
-    }
-    if (settings.backend == "auto") report.warn("display", "no connected screen found (" + why + "): the booth would run headless");
-    else report.fail("display", "kms: " + why, ErrorKind::Device);
+    checkBackends("display", "display.backend", displayBackends(), settings, "headless", report);
 }
 
 void checkLandmarkModel(const fs::path& model, Report& report) {

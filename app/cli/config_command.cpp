@@ -22,14 +22,14 @@ void registerConfigCommand(CLI::App& app) {
     cmd->add_flag("--print-default", o->printDefault,
                   "Print the default booth.toml, every key with its doc (what the package installs)");
     cmd->add_flag("--reference", o->reference, "Print every key as Markdown tables (the README's config reference)");
-    cmd->add_option("--check", o->check, "Check a configuration file: errors name file, line and key (exit code 6)")
+    cmd->add_option("--check", o->check, "Check a configuration file: every mistake, each naming file, line and key (exit code 6)")
         ->check(CLI::ExistingFile);
     cmd->require_option(1);
     cmd->callback([o] {
         if (o->printDefault) std::cout << renderDefaultConfig();
         else if (o->reference) std::cout << renderConfigReference();
         else {
-            // A bad file throws BoothError(BadConfig): main prints "FILE:LINE: key: ..." and exits with 6.
+            // A bad file throws ConfigErrors: main prints each mistake as "FILE:LINE: key: ..." and exits with 6.
             loadBoothConfig(o->check);
             std::cout << o->check << ": OK\n";
         }

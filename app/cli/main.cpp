@@ -5,6 +5,8 @@
 #include <spdlog/spdlog.h>
 
 #include <iostream>
+#include <sstream>
+#include <string>
 
 int main(int argc, char** argv) {
     CLI::App app{"avatarbooth: a photo booth that turns a front and a side photo into a 3-D head"};
@@ -37,7 +39,9 @@ int main(int argc, char** argv) {
         const int code = app.exit(e);
         return code == 0 ? avatarbooth::kExitOk : avatarbooth::kExitUsage;
     } catch (const avatarbooth::BoothError& e) {
-        std::cerr << "avatarbooth: error: " << e.what() << "\n";
+        // One error a line (a configuration file with several mistakes lists them all).
+        std::istringstream lines(e.what());
+        for (std::string line; std::getline(lines, line);) std::cerr << "avatarbooth: error: " << line << "\n";
         return avatarbooth::exitCodeFor(e.kind());
     } catch (const std::exception& e) {
         std::cerr << "avatarbooth: internal error: " << e.what() << "\n";

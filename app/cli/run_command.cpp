@@ -5,6 +5,7 @@
 #include "common/error.h"
 #include "config/booth_config.h"
 #include "drivers/camera/camera_factory.h"
+#include "drivers/gpio/button_board.h"
 #include "kiosk/kiosk.h"
 #include "sim/sim_visitor.h"
 #include "sim/synthetic_visitor.h"
@@ -76,12 +77,14 @@ void registerRunCommand(CLI::App& app) {
         else if (fs::exists(kInstalledConfig)) config = loadBoothConfig(kInstalledConfig);
         const bool configured = !config.file.empty();
 
-        // Real devices when present, the simulated booth otherwise; "auto" resolves here so the choice is said once.
-        const bool simCamera = config.camera.backend == "sim" ||
-                               (config.camera.backend == "auto" && listCameras().empty());
-        if (simCamera && config.camera.backend == "auto") {
-            std::cerr << "avatarbooth: no camera found: running the simulated booth\n";
-            config.camera.backend = "sim";
+        // Real devices when present, the simulated booth otherwise. The camera's "auto" is resolved here, once, by
+        // the camera table's walk (the kiosk then opens exactly that camera): the simulated booth is exactly when
+        // that walk ends on the sim camera.
+        if (config.camera.backend == "auto") {
+            const CameraBackendChoice camera = chooseCameraBackend(config.camera);
+            spdlog::info("camera: {}", cameraChoiceLog(camera));
+            if (camera.backend == "sim") std::cerr << "avatarbooth: no camera found: running the simulated booth\n";
+            config.camera = resolvedCameraSettings(config.camera, camera);
         }
         if (!configured && !writable(config.sessions.directory)) {
             const fs::path fallback = userDataDir() / "sessions";
@@ -96,9 +99,8 @@ void registerRunCommand(CLI::App& app) {
             config.camera.simFolder = dir.string();
             std::cerr << "avatarbooth: the simulated camera shows the synthetic visitor in " << dir.string() << "\n";
         }
-        const bool simButtons = config.buttons.backend == "sim" ||
-                                (config.buttons.backend == "auto" && !fs::exists("/dev/" + config.buttons.chip) &&
-                                 !fs::exists(config.buttons.chip));
+        // The same walk the button board takes when the kiosk opens it.
+        const bool simButtons = chooseButtonBackend(config.buttons).backend->name == "sim";
         const bool visitor = o->visitor == "yes" ||
                              (o->visitor == "auto" && config.camera.backend == "sim" && simButtons &&
                               config.buttons.timeline.empty());

@@ -19,22 +19,26 @@
 namespace avatarbooth {
 namespace {
 
+// Every mistake found in the file so far, with the line it is on (the order they are reported in).
+using Mistakes = std::vector<std::pair<int, BoothError>>;
+
 // One table of the file being read. Each read marks its key as known; finish() then reports any key nobody read,
-// which is how a misspelt key becomes an error instead of a silently ignored line.
+// which is how a misspelt key becomes an error instead of a silently ignored line. A mistake is recorded and the
+// reading goes on (the key keeps its default), so that one pass finds every mistake in the file.
 class Table {
 public:
-    Table(const toml::table* table, std::string path, const std::string& file, int line)
-        : table_(table), path_(std::move(path)), file_(file), line_(line) {}
+    Table(const toml::table* table, std::string path, const std::string& file, int line, Mistakes& mistakes)
+        : table_(table), path_(std::move(path)), file_(file), line_(line), mistakes_(mistakes) {}
 
-    // A nested table (absent: an empty one, so every default stays).
+    // A nested table (absent, or a mistake: an empty one, so every default stays).
     Table sub(const std::string& key) {
         const toml::node* n = take(key);
-        if (!n) return Table(nullptr, qualified(key), file_, line_);
-        if (!n->is_table()) fail(n, key, "expected a table ([" + qualified(key) + "])");
-        return Table(n->as_table(), qualified(key), file_, static_cast<int>(n->source().begin.line));
+        if (n && !n->is_table()) refuse(n, key, "expected a table ([" + qualified(key) + "])");
+        if (!n || !n->is_table()) return Table(nullptr, qualified(key), file_, line_, mistakes_);
+        return Table(n->as_table(), qualified(key), file_, static_cast<int>(n->source().begin.line), mistakes_);
     }
 
-    // The key's value, checked against its type, range and choices (nothing when the key is absent).
+    // The key's value, checked against its type, range and choices (nothing when the key is absent or wrong).
     std::optional<ConfigValue> value(const ConfigKey& k) {
         const toml::node* n = take(k.name);
         if (!n) return std::nullopt;
@@ -42,20 +46,20 @@ public:
             case ConfigType::String:
             case ConfigType::Path:
             case ConfigType::ButtonCombo:
-                if (!n->is_string()) fail(n, k.name, "expected a string in quotes");
+                if (!n->is_string()) return refuse(n, k.name, "expected a string in quotes");
                 return n->as_string()->get();
             case ConfigType::Choice: {
-                if (!n->is_string()) fail(n, k.name, "expected one of " + list(k.choices));
+                if (!n->is_string()) return refuse(n, k.name, "expected one of " + list(k.choices));
                 const std::string v = n->as_string()->get();
                 if (std::find(k.choices.begin(), k.choices.end(), v) == k.choices.end())
-                    fail(n, k.name, "\"" + v + "\" is not one of " + list(k.choices));
+                    return refuse(n, k.name, "\"" + v + "\" is not one of " + list(k.choices));
                 return v;
             }
             case ConfigType::Bool:
-                if (!n->is_boolean()) fail(n, k.name, "expected true or false");
+                if (!n->is_boolean()) return refuse(n, k.name, "expected true or false");
                 return n->as_boolean()->get();
             case ConfigType::Integer: {
-                if (!n->is_integer()) fail(n, k.name, "expected a whole number");
+                if (!n->is_integer()) return refuse(n, k.name, "expected a whole number");
                 const long long v = n->as_integer()->get();
                 const auto lo = static_cast<long long>(k.min), hi = static_cast<long long>(k.max);
                 if (k.step > 1 && (v < lo || v > hi || (v - lo) % k.step != 0)) {
@@ -64,83 +68,95 @@ public:
                     std::string words;
                     for (std::size_t i = 0; i < allowed.size(); ++i)
                         words += (i ? (i + 1 == allowed.size() ? " or " : ", ") : "") + allowed[i];
-                    fail(n, k.name, "must be " + words);
+                    return refuse(n, k.name, "must be " + words);
                 }
                 if (v < lo || v > hi)
-                    fail(n, k.name, "must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got " + std::to_string(v));
+                    return refuse(n, k.name, "must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got " + std::to_string(v));
                 return v;
             }
             case ConfigType::Number:
             case ConfigType::Seconds: {
-                if (!n->is_number()) fail(n, k.name, "expected a number");
+                if (!n->is_number()) return refuse(n, k.name, "expected a number");
                 const double v = n->is_integer() ? static_cast<double>(n->as_integer()->get()) : n->as_floating_point()->get();
                 if (!(v >= k.min && v <= k.max))
-                    fail(n, k.name, "must be between " + num(k.min) + " and " + num(k.max) + ", got " + num(v));
+                    return refuse(n, k.name, "must be between " + num(k.min) + " and " + num(k.max) + ", got " + num(v));
                 return v;
             }
             case ConfigType::WordList: {
                 const toml::array* a = n->as_array();
-                if (!a) fail(n, k.name, "expected a list in brackets of " + list(k.choices));
+                if (!a) return refuse(n, k.name, "expected a list in brackets of " + list(k.choices));
                 std::vector<std::string> words;
                 for (const toml::node& e : *a) {
-                    if (!e.is_string()) fail(&e, k.name, "expected words in quotes, each one of " + list(k.choices));
+                    if (!e.is_string()) return refuse(&e, k.name, "expected words in quotes, each one of " + list(k.choices));
                     const std::string v = e.as_string()->get();
                     if (std::find(k.choices.begin(), k.choices.end(), v) == k.choices.end())
-                        fail(&e, k.name, "\"" + v + "\" is not one of " + list(k.choices));
+                        return refuse(&e, k.name, "\"" + v + "\" is not one of " + list(k.choices));
                     if (std::find(words.begin(), words.end(), v) != words.end())
-                        fail(&e, k.name, "\"" + v + "\" is listed twice");
+                        return refuse(&e, k.name, "\"" + v + "\" is listed twice");
                     words.push_back(v);
                 }
                 if (words.size() < k.minCount)
-                    fail(n, k.name, "name at least " + std::to_string(k.minCount) + " of " + list(k.choices));
+                    return refuse(n, k.name, "name at least " + std::to_string(k.minCount) + " of " + list(k.choices));
                 return words;
             }
         }
-        fail(n, k.name, "has a type the schema does not know");
+        return refuse(n, k.name, "has a type the schema does not know");
     }
 
-    // An array of tables ([[key]]): one Table per element (nothing when the key is absent).
+    // An array of tables ([[key]]): one Table per element (nothing when the key is absent or wrong).
     std::optional<std::vector<Table>> tables(const std::string& key) {
         const toml::node* n = take(key);
         if (!n) return std::nullopt;
         const toml::array* a = n->as_array();
-        if (!a || !a->is_array_of_tables()) fail(n, key, "expected tables ([[" + qualified(key) + "]])");
+        if (!a || !a->is_array_of_tables()) return refuse(n, key, "expected tables ([[" + qualified(key) + "]])");
         std::vector<Table> out;
         for (const toml::node& e : *a)
             out.emplace_back(e.as_table(), qualified(key) + "[" + std::to_string(out.size()) + "]", file_,
-                             static_cast<int>(e.source().begin.line));
+                             static_cast<int>(e.source().begin.line), mistakes_);
         return out;
     }
     // Every key of a table of strings (key = "value"), each value one of `choices` unless that is empty.
     bool readStringMap(const std::string& key, std::map<std::string, std::string>& out, const std::vector<std::string>& choices) {
         const toml::node* n = take(key);
         if (!n) return false;
-        if (!n->is_table()) fail(n, key, "expected a table of \"key\" = \"value\" lines");
+        if (!n->is_table()) {
+            refuse(n, key, "expected a table of \"key\" = \"value\" lines");
+            return false;
+        }
         out.clear();
         for (const auto& [k, v] : *n->as_table()) {
             const std::string name = key + "." + std::string(k.str());
-            if (!v.is_string()) fail(&v, name, "expected a string in quotes");
+            if (!v.is_string()) {
+                refuse(&v, name, "expected a string in quotes");
+                continue;
+            }
             const std::string value = v.as_string()->get();
-            if (!choices.empty() && std::find(choices.begin(), choices.end(), value) == choices.end())
-                fail(&v, name, "\"" + value + "\" is not one of " + list(choices));
+            if (!choices.empty() && std::find(choices.begin(), choices.end(), value) == choices.end()) {
+                refuse(&v, name, "\"" + value + "\" is not one of " + list(choices));
+                continue;
+            }
             out[std::string(k.str())] = value;
         }
         return true;
     }
 
-    [[noreturn]] void fail(const toml::node* n, const std::string& key, const std::string& what) const {
+    // Records "FILE:LINE: table.key: what" (the line of `n`, else the table's); nothing, for the caller to return.
+    std::nullopt_t refuse(const toml::node* n, const std::string& key, const std::string& what) const {
         const int line = n ? static_cast<int>(n->source().begin.line) : line_;
-        throw BoothError(ErrorKind::BadConfig, file_ + ":" + std::to_string(line), qualified(key) + ": " + what);
+        mistakes_.emplace_back(line, BoothError(ErrorKind::BadConfig, file_ + ":" + std::to_string(line),
+                                                qualified(key) + ": " + what));
+        return std::nullopt;
     }
-    [[noreturn]] void failHere(const std::string& key, const std::string& what) const { fail(nodeOf(key), key, what); }
+    void refuseHere(const std::string& key, const std::string& what) const { refuse(nodeOf(key), key, what); }
+    std::size_t mistakesSoFar() const { return mistakes_.size(); }
 
-    // Reports the first key that no read asked for.
+    // Reports every key that no read asked for.
     void finish() const {
         if (!table_) return;
         for (const auto& [k, v] : *table_)
             if (!known_.count(std::string(k.str())))
-                fail(&v, std::string(k.str()), std::string(v.is_table() ? "unknown table" : "unknown key") +
-                                                    " (see the reference booth.toml for the keys there are)");
+                refuse(&v, std::string(k.str()), std::string(v.is_table() ? "unknown table" : "unknown key") +
+                                                      " (see the reference booth.toml for the keys there are)");
     }
 
 private:
@@ -165,6 +181,7 @@ private:
     std::string path_;
     const std::string& file_;
     int line_;
+    Mistakes& mistakes_;
     std::set<std::string> known_;
 };
 
@@ -199,23 +216,26 @@ void readChildren(Table& t, const std::string& parent, BoothConfig& config) {
     }
 }
 
-// One table: its keys, its sub-tables, the schema's rule across them, then any key left over is an error.
+// One table: its keys, its sub-tables, the schema's rule across them, then any key left over is an error. The rule
+// is checked only when the table's own keys were right: with one of them wrong (and left at its default) it would
+// blame a key that is not the mistake.
 void readTable(Table& t, const std::string& name, const ConfigTable* schema, BoothConfig& config, std::size_t element) {
+    const std::size_t mistakesBefore = t.mistakesSoFar();
     for (const ConfigKey& k : configKeys()) {
         if (k.table != name) continue;
         if (const std::optional<ConfigValue> v = t.value(k)) {
             try {
                 k.set(config, element, *v);
             } catch (const ConfigValueRejected& rejected) {
-                t.failHere(k.name, rejected.what);
+                t.refuseHere(k.name, rejected.what);
             }
         } else if (k.required) {
-            t.failHere(k.name, "every [[" + name + "]] needs a " + k.name);
+            t.refuseHere(k.name, "every [[" + name + "]] needs a " + k.name);
         }
     }
     readChildren(t, name, config);
-    if (schema && schema->check)
-        if (const std::optional<ConfigProblem> problem = schema->check(config)) t.failHere(problem->key, problem->what);
+    if (schema && schema->check && t.mistakesSoFar() == mistakesBefore)
+        if (const std::optional<ConfigProblem> problem = schema->check(config)) t.refuseHere(problem->key, problem->what);
     t.finish();
 }
 
@@ -226,20 +246,27 @@ BoothConfig parseBoothConfig(const std::string& text, const std::string& name) {
     try {
         root = toml::parse(text, name);
     } catch (const toml::parse_error& e) {
-        throw BoothError(ErrorKind::BadConfig, name + ":" + std::to_string(e.source().begin.line),
-                         std::string("not valid TOML: ") + std::string(e.description()));
+        // toml++ stops at the first syntax error: the one mistake there is to report.
+        throw ConfigErrors({BoothError(ErrorKind::BadConfig, name + ":" + std::to_string(e.source().begin.line),
+                                       std::string("not valid TOML: ") + std::string(e.description()))});
     }
     BoothConfig config;
     config.file = name;
-    Table top(&root, "", name, 1);
+    Mistakes mistakes;
+    Table top(&root, "", name, 1, mistakes);
     readTable(top, "", nullptr, config, 0);
+    const auto lineOf = [&](const char* key) {
+        const toml::node* n = root.at_path(key).node();
+        return n ? static_cast<int>(n->source().begin.line) : 0;
+    };
     // [reveal] styles and [character] enabled: a style listed that no fit would make would silently never show;
-    // not listed at all, the default list drops what is switched off.
-    if (!config.character.enabled && config.reveal.shows(AvatarStyle::Character)) {
-        if (const toml::node* styles = root.at_path("reveal.styles").node())
-            throw BoothError(ErrorKind::BadConfig, name + ":" + std::to_string(styles->source().begin.line),
-                             "reveal.styles: \"character\" is listed but [character] enabled = false (remove it "
-                             "here, or enable it)");
+    // not listed at all, the default list drops what is switched off. (With a mistake already found the two may
+    // be defaults standing in for what the file meant: not checked then.)
+    if (mistakes.empty() && !config.character.enabled && config.reveal.shows(AvatarStyle::Character)) {
+        if (const int line = lineOf("reveal.styles"))
+            mistakes.emplace_back(line, BoothError(ErrorKind::BadConfig, name + ":" + std::to_string(line),
+                                                   "reveal.styles: \"character\" is listed but [character] enabled "
+                                                   "= false (remove it here, or enable it)"));
         std::erase(config.reveal.styles, AvatarStyle::Character);
     }
     // A map given in the file is relative to the file (as an operator writes it next to booth.toml).
@@ -251,13 +278,35 @@ BoothConfig parseBoothConfig(const std::string& text, const std::string& name) {
         try {
             (void)stage::buildStage(stage::loadTileMap(config.stage.map));
         } catch (const BoothError& e) {
-            throw BoothError(ErrorKind::BadConfig, e.where(), std::string("[stage] map: ") + e.what());
+            mistakes.emplace_back(lineOf("stage.map"),
+                                  BoothError(ErrorKind::BadConfig, e.where(), std::string("[stage] map: ") + e.what()));
         }
+    }
+    if (!mistakes.empty()) {
+        std::stable_sort(mistakes.begin(), mistakes.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+        std::vector<BoothError> inOrder;
+        for (auto& [line, mistake] : mistakes) inOrder.push_back(std::move(mistake));
+        throw ConfigErrors(std::move(inOrder));
     }
     // The screen draws the oval the guidance measures against: one setting, two users.
     config.screen.oval = config.guidance.oval;
     return config;
 }
+
+namespace {
+
+// The first mistake's message without its "FILE:LINE: " (BoothError puts it back), then the others, one a line.
+std::string listed(const std::vector<BoothError>& mistakes) {
+    const BoothError& first = mistakes.at(0);
+    std::string out = std::string(first.what()).substr(first.where().empty() ? 0 : first.where().size() + 2);
+    for (std::size_t i = 1; i < mistakes.size(); ++i) out += "\n" + std::string(mistakes[i].what());
+    return out;
+}
+
+}  // namespace
+
+ConfigErrors::ConfigErrors(std::vector<BoothError> mistakes)
+    : BoothError(ErrorKind::BadConfig, mistakes.at(0).where(), listed(mistakes)), mistakes_(std::move(mistakes)) {}
 
 BoothConfig loadBoothConfig(const std::filesystem::path& file) {
     std::ifstream in(file, std::ios::binary);

@@ -2,7 +2,8 @@
 //
 // Every key has a default (the struct's own), so an empty file is a valid configuration. The file is read
 // strictly: an unknown table or key, a value of the wrong type or out of range is an error naming the file, the
-// line and the key (ErrorKind::BadConfig), so a typo never silently falls back to a default. Every key, its type,
+// line and the key (ErrorKind::BadConfig), so a typo never silently falls back to a default; every mistake in the
+// file is reported at once. Every key, its type,
 // range and doc are in config/config_schema.h; the reference with the defaults is `avatarbooth config
 // --print-default` (kept as app/assets/booth.toml, installed as /etc/avatarbooth/booth.toml).
 #pragma once
@@ -19,10 +20,12 @@
 #include "reveal/styles/style_settings.h"
 #include "fit/fit_pipeline.h"
 #include "booth/screens/screens.h"
+#include "common/error.h"
 
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace avatarbooth {
 
@@ -57,8 +60,19 @@ struct BoothConfig {
     StageSettings stage;            // [stage]
 };
 
-// Reads and checks a configuration file. Throws BoothError(BadConfig) with "FILE:LINE: key: what is wrong", or
-// BoothError(BadInput) when the file cannot be read.
+// Every mistake in a configuration file, in line order, each a BoothError(BadConfig) "FILE:LINE: key: what is
+// wrong"; what() lists them one a line (a single mistake reads as it always did), where() is the first one's.
+class ConfigErrors : public BoothError {
+public:
+    explicit ConfigErrors(std::vector<BoothError> mistakes);  // at least one
+    const std::vector<BoothError>& mistakes() const { return mistakes_; }
+
+private:
+    std::vector<BoothError> mistakes_;
+};
+
+// Reads and checks a configuration file. Throws ConfigErrors naming every mistake (in a file that is not valid
+// TOML: its first syntax error), or BoothError(BadInput) when the file cannot be read.
 BoothConfig loadBoothConfig(const std::filesystem::path& file);
 
 // The same from text (`name` stands for the file in messages).

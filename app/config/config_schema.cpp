@@ -1,6 +1,9 @@
 // Every table and key of booth.toml, and the default file and Markdown reference rendered from them.
 #include "config/config_schema.h"
 
+#include "drivers/camera/camera_backends.h"
+#include "drivers/display/display_backends.h"
+#include "drivers/gpio/button_backends.h"
 #include "reveal/character/proportions.h"
 #include "fit/head/rbf.h"
 
@@ -49,6 +52,16 @@ ConfigKey choice(std::string table, std::string name, Ref ref, std::vector<std::
     ConfigKey k = textKey(std::move(table), std::move(name), ConfigType::Choice, ref, std::move(doc));
     k.choices = std::move(choices);
     return k;
+}
+
+// A device kind's `backend` key: the words are the kind's backend table's names after "auto" (so the file accepts
+// exactly what the factories open), and the doc lists them after what "auto" does.
+template <typename Ref, typename Entry>
+ConfigKey backendChoice(std::string table, Ref ref, std::span<const Entry> backends, const std::string& autoDoes) {
+    std::vector<std::string> words = backendWords(backends);
+    std::string doc = "\"auto\" (" + autoDoes + ")";
+    for (std::size_t i = 1; i < words.size(); ++i) doc += ", \"" + words[i] + "\"";
+    return choice(std::move(table), "backend", ref, std::move(words), doc + ".");
 }
 
 template <typename Ref>
@@ -330,9 +343,8 @@ std::vector<ConfigKey> makeKeys() {
     k.push_back(integer("fit", "preview_size", FIELD(fit.previewSize), 64, 4096,
                         "The preview renders of a session, pixels per side."));
     // [camera]
-    k.push_back(choice("camera", "backend", FIELD(camera.backend), {"auto", "v4l2", "libcamera", "sim"},
-                       "\"auto\" (a V4L2 camera if there is one, else libcamera, else the simulated camera), "
-                       "\"v4l2\", \"libcamera\", \"sim\"."));
+    k.push_back(backendChoice("camera", FIELD(camera.backend), cameraBackends(),
+                              "a V4L2 camera if there is one, else libcamera, else the simulated camera"));
     k.push_back(text("camera", "device", FIELD(camera.device),
                      "v4l2: \"/dev/video0\" or a stable /dev/v4l/by-id/... name; libcamera: the camera id from "
                      "`avatarbooth check`; \"\" = the first one found."));
@@ -362,8 +374,8 @@ std::vector<ConfigKey> makeKeys() {
     k.push_back(number("camera", "reopen_max_delay_s", FIELD(camera.reopenMaxDelaySeconds), 0.01, 600.0,
                        "The longest delay between reopening attempts."));
     // [buttons]
-    k.push_back(choice("buttons", "backend", FIELD(buttons.backend), {"auto", "gpiod", "sim"},
-                       "\"auto\" (the GPIO chip when it exists, else simulated), \"gpiod\", \"sim\"."));
+    k.push_back(backendChoice("buttons", FIELD(buttons.backend), buttonBackends(),
+                              "the GPIO chip when it exists, else simulated"));
     k.push_back(text("buttons", "chip", FIELD(buttons.chip),
                      "The GPIO chip by label (\"pinctrl-bcm2711\"), name (\"gpiochip0\"), path or number."));
     k.push_back(integer("buttons", "debounce_ms", FIELD(buttons.debounceMs), 0, 1000,
@@ -395,9 +407,8 @@ std::vector<ConfigKey> makeKeys() {
     k.push_back(flag("buttons.lamp", "active_low", ELEMENT(buttons.lamps[i].activeLow),
                      "The lamp lights with the line low (many relay boards)."));
     // [display]
-    k.push_back(choice("display", "backend", FIELD(display.backend), {"auto", "kms", "window", "headless"},
-                       "\"auto\" (KMS when a screen is connected, else a window when $DISPLAY is set, else "
-                       "headless), \"kms\", \"window\", \"headless\"."));
+    k.push_back(backendChoice("display", FIELD(display.backend), displayBackends(),
+                              "KMS when a screen is connected, else a window when $DISPLAY is set, else headless"));
     k.push_back(integer("display", "rotation", FIELD(display.rotation), 0, 270,
                         "Degrees the picture is turned clockwise for the panel (portrait panels: 90 or 270).", 90));
     k.push_back(integer("display", "width", FIELD(display.width), 64, 8192,

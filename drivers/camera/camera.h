@@ -38,7 +38,7 @@ struct CameraDescription {
     std::string name;     // what the device calls itself (V4L2 card, libcamera model), or "simulated camera"
     CameraStreamFormat preview;
     CameraStreamFormat still;
-    std::string note;     // why this backend was chosen (set by openCamera), or empty
+    std::string note;     // why this backend was chosen (set by openReopeningCamera for "auto"), or empty
 
     // One line for logs and the operator screen, e.g.
     // "v4l2 /dev/video0 (HD Webcam): preview YUYV 1280x720 @30 fps, still MJPG 1920x1080".

@@ -1,4 +1,5 @@
-// The camera factory: backend choice, construction, and the machine's camera list.
+// The camera factory: the backend choice through the camera table, opening it behind reopening, and the
+// machine's camera list.
 #include "drivers/camera/camera_factory.h"
 
 #include "drivers/camera/libcamera_camera.h"
@@ -11,12 +12,6 @@
 namespace avatarbooth {
 
 namespace {
-
-// A node the v4l2 backend can stream from on its own: a capture node with a format we read, not one end of a
-// media-controller pipeline (those are libcamera's).
-bool usableV4l2(const V4l2DeviceInfo& info) {
-    return info.canCapture && !info.mediaControllerCentric && negotiateV4l2Format(info.formats, 0, 0, 0).has_value();
-}
 
 // Adds the reason for the choice to the description; everything else goes straight through.
 class ChosenCamera : public Camera {
@@ -37,22 +32,6 @@ private:
     std::string note_;
 };
 
-std::unique_ptr<Camera> openBackend(const CameraSettings& s, const CameraEnvironment& env) {
-    if (s.backend == "v4l2") return std::make_unique<V4l2Camera>(s);
-    if (s.backend == "libcamera") return std::make_unique<LibcameraCamera>(s);
-    if (s.backend == "sim") {
-        SimCameraOptions options;
-        options.folder = s.simFolder;
-        options.fps = s.simFps;
-        options.previewWidth = s.previewWidth;
-        options.previewHeight = s.previewHeight;
-        options.noise = s.simNoise;
-        return std::make_unique<SimCamera>(options, env.simControls, env.clock);
-    }
-    throw BoothError(ErrorKind::BadConfig, "camera.backend",
-                     "unknown camera backend \"" + s.backend + "\" (auto, v4l2, libcamera or sim)");
-}
-
 CameraEnvironment completed(const CameraSettings& s, CameraEnvironment env) {
     if (!env.simControls) env.simControls = std::make_shared<SimCameraControls>();
     if (!env.clock) {
@@ -71,56 +50,44 @@ std::chrono::nanoseconds seconds(double s) {
 }  // namespace
 
 CameraBackendChoice chooseCameraBackend(const CameraSettings& s) {
-    if (s.backend == "v4l2" || s.backend == "libcamera") return {s.backend, s.device, s.backend + " (configured)"};
-    if (s.backend == "sim") return {"sim", s.simFolder, "sim (configured)"};
-    if (s.backend != "auto")
-        throw BoothError(ErrorKind::BadConfig, "camera.backend",
-                         "unknown camera backend \"" + s.backend + "\" (auto, v4l2, libcamera or sim)");
-
-    const bool deviceIsNode = s.device.starts_with("/dev/");
-    std::vector<std::string> nodes = deviceIsNode ? std::vector<std::string>{s.device} : listV4l2Nodes();
-    if (s.device.empty() || deviceIsNode) {
-        for (const auto& node : nodes) {
-            const auto info = probeV4l2Device(node);
-            if (usableV4l2(info))
-                return {"v4l2", node, "auto: V4L2 camera " + node + " (" + info.card + ") found"};
-        }
+    const std::span<const CameraBackend> table = cameraBackends();
+    if (s.backend != "auto") {
+        const CameraBackend* entry = findBackend(table, s.backend);
+        if (!entry)
+            throw BoothError(ErrorKind::BadConfig, "camera.backend",
+                             "unknown camera backend \"" + s.backend + "\" (" + backendWordList(table) + ")");
+        const bool sim = s.backend == "sim";
+        return {entry, s.backend, sim ? s.simFolder : s.device, s.backend + " (configured)", false, ""};
     }
-    if (!deviceIsNode) {
-        try {
-            const auto cameras = listLibcameraCameras();
-            for (const auto& c : cameras)
-                if (s.device.empty() || c.id == s.device)
-                    return {"libcamera", c.id, "auto: libcamera camera " + c.id + (c.model.empty() ? "" : " (" + c.model + ")") + " found"};
-        } catch (const BoothError& e) {
-            spdlog::debug("camera auto: libcamera unavailable: {}", e.what());
-        }
+    const BackendChoice<CameraBackend> choice = probeBackends(table, s);
+    // The table ends with the sim camera, which is always usable.
+    const std::string name(choice.backend->name);
+    std::string reason = "auto: " + choice.probe.text;
+    if (name == "sim") {
+        const std::string looked = s.device.empty() ? "no V4L2 or libcamera camera found" : "camera " + s.device + " not found";
+        reason = "auto: " + looked + ", using the simulated camera";
     }
-    const std::string looked = s.device.empty() ? "no V4L2 or libcamera camera found" : "camera " + s.device + " not found";
-    return {"sim", s.simFolder, "auto: " + looked + ", using the simulated camera"};
+    return {choice.backend, name, name == "sim" ? s.simFolder : choice.probe.device, reason, true, passedOver(choice.passed)};
 }
 
-std::unique_ptr<Camera> openCamera(const CameraSettings& settings, CameraEnvironment environment) {
-    const auto choice = chooseCameraBackend(settings);
-    auto resolved = settings;
+std::string cameraChoiceLog(const CameraBackendChoice& choice) {
+    return choice.reason + (choice.passedOver.empty() ? "" : " (" + choice.passedOver + ")");
+}
+
+CameraSettings resolvedCameraSettings(const CameraSettings& settings, const CameraBackendChoice& choice) {
+    CameraSettings resolved = settings;
     resolved.backend = choice.backend;
     if (choice.backend != "sim") resolved.device = choice.device;
-    const auto env = completed(resolved, std::move(environment));
-    auto camera = openBackend(resolved, env);
-    if (settings.backend != "auto") return camera;
-    spdlog::info("camera: {}", choice.reason);
-    return std::make_unique<ChosenCamera>(std::move(camera), choice.reason);
+    return resolved;
 }
 
 std::unique_ptr<ReopeningCamera> openReopeningCamera(const CameraSettings& settings, CameraEnvironment environment) {
-    const auto choice = chooseCameraBackend(settings);
-    auto resolved = settings;
-    resolved.backend = choice.backend;
-    if (choice.backend != "sim") resolved.device = choice.device;
-    const auto env = completed(resolved, std::move(environment));
-    if (settings.backend == "auto") spdlog::info("camera: {}", choice.reason);
-    const std::string note = settings.backend == "auto" ? choice.reason : std::string();
-    auto open = [resolved, env, note]() -> std::unique_ptr<Camera> {
+    const CameraBackendChoice choice = chooseCameraBackend(settings);
+    const CameraSettings resolved = resolvedCameraSettings(settings, choice);
+    const CameraEnvironment env = completed(resolved, std::move(environment));
+    if (choice.automatic) spdlog::info("camera: {}", cameraChoiceLog(choice));
+    const std::string note = choice.automatic ? choice.reason : std::string();
+    auto opener = [openBackend = choice.entry->open, resolved, env, note]() -> std::unique_ptr<Camera> {
         auto camera = openBackend(resolved, env);
         if (note.empty()) return camera;
         return std::make_unique<ChosenCamera>(std::move(camera), note);
@@ -128,7 +95,7 @@ std::unique_ptr<ReopeningCamera> openReopeningCamera(const CameraSettings& setti
     const std::string label = choice.backend == "sim" ? "sim:" + choice.device
                               : choice.device.empty() ? choice.backend : choice.device;
     const ReopenPolicy policy{seconds(settings.reopenFirstDelaySeconds), seconds(settings.reopenMaxDelaySeconds)};
-    return std::make_unique<ReopeningCamera>(open, label, policy, env.clock);
+    return std::make_unique<ReopeningCamera>(opener, label, policy, env.clock);
 }
 
 std::vector<CameraListEntry> listCameras() {
@@ -139,14 +106,12 @@ std::vector<CameraListEntry> listCameras() {
         e.backend = "v4l2";
         e.device = node;
         e.name = info.card.empty() ? "" : info.card + " [" + info.driver + ", " + info.bus + "]";
-        if (!info.error.empty())
-            e.formats = info.error;
-        else if (!info.canCapture)
-            e.formats = "not a single-planar video capture node";
+        e.usable = v4l2Unusable(info).empty();
+        if (!info.error.empty() || !info.canCapture)
+            e.formats = v4l2Unusable(info);
         else
             e.formats = (info.mediaControllerCentric ? "media-controller node (use libcamera): " : "") +
                         describeV4l2Formats(info.formats);
-        e.usable = usableV4l2(info);
         list.push_back(std::move(e));
     }
     try {

@@ -1,12 +1,12 @@
-// Opening the camera the settings ask for ("auto" picks a real one when present, else the simulated one), and
-// listing the cameras on this machine for `avatarbooth check`.
+// Opening the camera the settings ask for ("auto" takes the first backend of the camera table that finds a
+// camera: a real one when present, else the simulated one), and listing the cameras on this machine for
+// `avatarbooth check`.
 #pragma once
 
 #include "drivers/camera/camera.h"
-#include "drivers/camera/camera_clock.h"
+#include "drivers/camera/camera_backends.h"
 #include "drivers/camera/camera_settings.h"
 #include "drivers/camera/reopening_camera.h"
-#include "drivers/camera/sim_camera.h"
 
 #include <memory>
 #include <string>
@@ -14,32 +14,31 @@
 
 namespace avatarbooth {
 
-// What the cameras share with the rest of the booth.
-struct CameraEnvironment {
-    // The simulated world (scene, faults) the sim camera reads; one is made when null. Keep it to drive the
-    // simulation: a reopened sim camera reads the same one.
-    std::shared_ptr<SimCameraControls> simControls;
-    // The clock of the sim camera and of reopen back-off; null: the steady clock, or for a sim camera with
-    // simRealTime = false a manual clock starting at 0 (frames as fast as asked).
-    std::shared_ptr<CameraClock> clock;
-};
-
 struct CameraBackendChoice {
+    const CameraBackend* entry = nullptr;  // its row in cameraBackends()
     std::string backend;  // "v4l2", "libcamera" or "sim"
     std::string device;   // the device node / camera id / sim folder it will open
     std::string reason;   // e.g. "auto: no V4L2 or libcamera camera found, using the simulated camera"
+    bool automatic = false;  // chosen by "auto" (else configured by name, and not probed)
+    std::string passedOver;  // auto: why the earlier backends were passed over ("v4l2: ...; libcamera: ..."), or ""
 };
 
-// Resolves settings.backend ("auto" probes V4L2 nodes, then libcamera; an explicit backend is taken as it is).
-// Throws BoothError(BadConfig) for an unknown backend name.
+// Resolves settings.backend: "auto" walks cameraBackends() in order and takes the first whose probe finds a
+// camera; a name is looked up in the same table and taken as it is. Throws BoothError(BadConfig) for an unknown
+// backend name.
 CameraBackendChoice chooseCameraBackend(const CameraSettings& settings);
 
-// Opens the camera (not yet streaming). For "auto" the choice and its reason are logged and put in
-// describe().note. Throws what the backend throws (BoothError Device for a missing device, naming it).
-std::unique_ptr<Camera> openCamera(const CameraSettings& settings, CameraEnvironment environment = {});
+// The choice for the start-up log: the reason and, for "auto", why the earlier backends were passed over.
+std::string cameraChoiceLog(const CameraBackendChoice& choice);
 
-// The same camera wrapped so that it is reopened with back-off when it goes away. "auto" is resolved once, so
-// a lost USB camera is waited for rather than replaced by the simulated one.
+// The settings with the choice made: the backend named, and the device it found (so opening them again probes
+// nothing and opens the same camera).
+CameraSettings resolvedCameraSettings(const CameraSettings& settings, const CameraBackendChoice& choice);
+
+// Opens the camera (not yet streaming), wrapped so that it is reopened with back-off when it goes away; the one
+// way to open a camera. "auto" is resolved once, so a lost USB camera is waited for rather than replaced by the
+// simulated one; the choice and its reason are logged and put in describe().note. A missing device is not thrown
+// (the camera starts out lost and says why in status()); a bad configuration or sim folder is.
 std::unique_ptr<ReopeningCamera> openReopeningCamera(const CameraSettings& settings, CameraEnvironment environment = {});
 
 struct CameraListEntry {

@@ -3,6 +3,7 @@
 #include "drivers/camera/libcamera_camera.h"
 
 #include "drivers/camera/frame_conversion.h"
+#include "drivers/camera/libcamera_log.h"
 
 #include <libcamera/libcamera.h>
 #include <spdlog/spdlog.h>
@@ -31,6 +32,7 @@ std::shared_ptr<lc::CameraManager> sharedCameraManager() {
     static std::weak_ptr<lc::CameraManager> shared;
     std::lock_guard lock(mutex);
     if (auto manager = shared.lock()) return manager;
+    routeLibcameraLogToSpdlog();
     std::shared_ptr<lc::CameraManager> manager(new lc::CameraManager, [](lc::CameraManager* m) {
         m->stop();
         delete m;

@@ -155,11 +155,18 @@ V4l2DeviceInfo probeV4l2Device(const std::string& path) {
     return info;
 }
 
+std::string v4l2Unusable(const V4l2DeviceInfo& info) {
+    if (!info.error.empty()) return info.error;
+    if (!info.canCapture) return "not a single-planar video capture node";
+    if (info.mediaControllerCentric) return "media-controller node (use libcamera)";
+    if (!negotiateV4l2Format(info.formats, 0, 0, 0)) return "offers no format the booth reads (YUYV, MJPEG, RGB)";
+    return "";
+}
+
 V4l2Camera::V4l2Camera(const CameraSettings& settings) : settings_(settings), device_(settings.device) {
     if (device_.empty()) {
         for (const auto& node : listV4l2Nodes()) {
-            const auto info = probeV4l2Device(node);
-            if (info.canCapture && !info.mediaControllerCentric && negotiateV4l2Format(info.formats, 0, 0, 0)) {
+            if (v4l2Unusable(probeV4l2Device(node)).empty()) {
                 device_ = node;
                 break;
             }

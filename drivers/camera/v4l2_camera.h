@@ -29,6 +29,9 @@ struct V4l2DeviceInfo {
 
 // Opens and queries a node without streaming; never throws (errors land in `error`).
 V4l2DeviceInfo probeV4l2Device(const std::string& path);
+// Why the v4l2 backend cannot stream from the node on its own, "" when it can: the node is a capture node with a
+// format we read, not one end of a media-controller pipeline (those are libcamera's).
+std::string v4l2Unusable(const V4l2DeviceInfo& info);
 // The /dev/video* nodes in numeric order.
 std::vector<std::string> listV4l2Nodes();
 

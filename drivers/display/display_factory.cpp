@@ -1,55 +1,42 @@
-// Display selection: kms, window, headless, or the first that works.
+// Display selection through the display table: a backend by name, or the first that works.
 #include "drivers/display/display_factory.h"
 
 #include "common/error.h"
-#include "drivers/display/headless_display.h"
-#include "drivers/display/kms_display.h"
-#include "drivers/display/window_display.h"
-
-#include <cstdlib>
+#include "drivers/display/display_backends.h"
 
 namespace avatarbooth {
 
 OpenedDisplay createDisplay(const DisplaySettings& settings) {
     rotationFromDegrees(settings.rotation);  // a bad rotation is a config error whichever backend is chosen
+    const std::span<const DisplayBackend> table = displayBackends();
     OpenedDisplay out;
-    const std::string& b = settings.backend;
-    if (b == "kms") out.display = std::make_unique<KmsDisplay>(settings);
-    else if (b == "window") out.display = std::make_unique<WindowDisplay>(settings);
-    else if (b == "headless") out.display = std::make_unique<HeadlessDisplay>(settings);
-    if (out.display) {
+    if (settings.backend != "auto") {
+        const DisplayBackend* entry = findBackend(table, settings.backend);
+        if (!entry)
+            throw BoothError(ErrorKind::BadConfig, "display.backend",
+                             "\"" + settings.backend + "\" is not a display (" + backendWordList(table) + ")");
+        out.display = entry->open(settings);
         out.description = "display: " + out.display->describe();
         return out;
     }
-    if (b != "auto")
-        throw BoothError(ErrorKind::BadConfig, "display.backend",
-                         "\"" + b + "\" is not a display (auto, kms, window or headless)");
-
-    std::string passed;
-    std::string why;
-    if (kmsScreenAvailable(settings.drmDevice, settings.connector, &why)) {
+    // A backend whose probe passes may still fail to open (an X server that refuses us, a GPU EGL cannot drive):
+    // it is passed over like one whose probe failed, and the walk goes on after it.
+    std::vector<PassedBackend> passed;
+    for (std::size_t from = 0;;) {
+        BackendChoice<DisplayBackend> choice = probeBackends(table, settings, from);
+        passed.insert(passed.end(), choice.passed.begin(), choice.passed.end());
+        if (!choice.backend) throw BoothError(ErrorKind::Device, "display", "no display backend opens: " + passedOver(passed));
         try {
-            out.display = std::make_unique<KmsDisplay>(settings);
+            out.display = choice.backend->open(settings);
         } catch (const BoothError& e) {
-            why = e.what();
+            passed.push_back({std::string(choice.backend->name), e.what()});
+            from = static_cast<std::size_t>(choice.backend - table.data()) + 1;
+            continue;
         }
+        choice.passed = std::move(passed);
+        out.description = "display: " + out.display->describe() + " (" + autoReason(choice) + ")";
+        return out;
     }
-    if (!out.display) {
-        passed = "kms: " + why;
-        const char* x = std::getenv("DISPLAY");
-        if (x != nullptr && *x != '\0') {
-            try {
-                out.display = std::make_unique<WindowDisplay>(settings);
-            } catch (const BoothError& e) {
-                passed += "; window: " + std::string(e.what());
-            }
-        } else {
-            passed += "; window: $DISPLAY is not set";
-        }
-    }
-    if (!out.display) out.display = std::make_unique<HeadlessDisplay>(settings);
-    out.description = "display: " + out.display->describe() + " (auto" + (passed.empty() ? "" : ": " + passed) + ")";
-    return out;
 }
 
 }  // namespace avatarbooth

@@ -1,4 +1,5 @@
-// Choosing the display by name: "auto", "kms", "window" or "headless".
+// Opening the display the settings name, or for "auto" the first of the display table (display_backends.h) that
+// works.
 #pragma once
 
 #include "drivers/display/display.h"
@@ -11,14 +12,15 @@ namespace avatarbooth {
 
 struct OpenedDisplay {
     std::unique_ptr<Display> display;
-    // Which backend and why, for the start-up log: "display: headless 1280x720 (auto: no DRM device ...;
-    // $DISPLAY is not set)".
+    // Which backend and why, for the start-up log: "display: headless 1280x720 (auto: kms: no DRM device ...;
+    // window: $DISPLAY is not set)".
     std::string description;
 };
 
-// Opens settings.backend. "auto" tries kms when a DRM device has a connected screen, then window when $DISPLAY
-// is set, then headless, and says why each earlier one was passed over (a failure to open is reported, not
-// thrown). A named backend that cannot open throws its BoothError(Device); an unknown name is BadConfig.
+// Opens settings.backend. "auto" walks displayBackends() (kms when a DRM device has a connected screen, then window
+// when $DISPLAY is set, then headless) and says why each earlier one was passed over (a failure to open is
+// reported and passed over too, not thrown). A named backend that cannot open throws its BoothError(Device); a
+// name the table does not have is BadConfig.
 OpenedDisplay createDisplay(const DisplaySettings& settings);
 
 }  // namespace avatarbooth

@@ -1,6 +1,7 @@
 // Opening the booth's buttons and lamps from GpioSettings: GPIO (libgpiod) or the simulation, plus keyboard keys.
 #pragma once
 
+#include "drivers/gpio/button_backends.h"
 #include "drivers/gpio/buttons.h"
 #include "drivers/gpio/clock.h"
 #include "drivers/gpio/debouncer.h"
@@ -10,6 +11,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace avatarbooth {
 
@@ -21,10 +23,19 @@ struct ButtonBoard {
     std::string description;            // for the start-up log: which backend and why
 };
 
+// The backend openButtonBoard opens: the one named (not probed), or for "auto" the first of buttonBackends() whose
+// probe passes, with why the earlier ones were passed over. A name the table does not have is BoothError
+// BadConfig.
+BackendChoice<ButtonBackend> chooseButtonBackend(const GpioSettings& settings);
+
 // Checks the settings (unique names and offsets, debounce 0-1000 ms, known backend; BoothError BadConfig naming
-// the field) and opens the backend. "auto" takes gpiod when the chip can be opened and the sim otherwise. The sim
-// runs on `clock` from now on (its timeline counts from this call), which must outlive the board.
+// the field) and opens the backend chooseButtonBackend gives: for "auto" gpiod when the chip can be opened and the
+// sim otherwise. The sim runs on `clock` from now on (its timeline counts from this call), which must outlive the
+// board.
 ButtonBoard openButtonBoard(const GpioSettings& settings, Clock& clock);
+
+// The configured buttons' names, in order.
+std::vector<std::string> configuredButtonNames(const GpioSettings& settings);
 
 // The debounce settings of one configured button.
 DebounceSettings debounceFor(const GpioSettings& settings, const ButtonSettings& button);

@@ -1,5 +1,5 @@
 // `avatarbooth config` as an operator runs it: the printed default is a valid file, a broken file is refused with
-// file, line and key and exit code 6, and the Markdown reference is the README's.
+// file, line and key of every mistake and exit code 6, and the Markdown reference is the README's.
 #include "run_binary.h"
 #include "test_paths.h"
 
@@ -35,6 +35,18 @@ TEST(ConfigCli, BrokenFileNamesFileLineAndKey) {
     const CommandResult r = runAvatarbooth("config --check " + file.string());
     EXPECT_EQ(r.exitCode, 6) << r.output;
     EXPECT_EQ(r.output, "avatarbooth: error: " + file.string() + ":5: display.rotation: must be 0, 90, 180 or 270\n");
+}
+
+TEST(ConfigCli, EveryMistakeIsListedAtOnce) {
+    const auto dir = scratchDir("config_cli_three");
+    const auto file = dir / "booth.toml";
+    write(file, "[camera]\nbackend = \"webcam\"\n\n[display]\nrotation = 45\nbogus = 1\n");
+    const CommandResult r = runAvatarbooth("config --check " + file.string());
+    EXPECT_EQ(r.exitCode, 6) << r.output;
+    const std::string prefix = "avatarbooth: error: " + file.string();
+    EXPECT_EQ(r.output, prefix + ":2: camera.backend: \"webcam\" is not one of \"auto\", \"v4l2\", \"libcamera\" or \"sim\"\n" +
+                            prefix + ":5: display.rotation: must be 0, 90, 180 or 270\n" + prefix +
+                            ":6: display.bogus: unknown key (see the reference booth.toml for the keys there are)\n");
 }
 
 TEST(ConfigCli, OneActionAtATime) {

@@ -1,5 +1,5 @@
-// The libcamera backend where libcamera finds no camera (this machine): the error path and the listing. The
-// vimc tests under qemu exercise streaming.
+// The libcamera backend where libcamera finds no camera (this machine): the error path, the listing and its own
+// log. The vimc tests under qemu exercise streaming.
 #include "drivers/camera/camera_factory.h"
 #include "drivers/camera/libcamera_camera.h"
 
@@ -34,4 +34,14 @@ TEST(CameraLibcamera, VersionAndListingWorkWithoutCameras) {
     for (const auto& c : listCameras())
         if (c.backend == "libcamera" && c.usable) ++listed;
     EXPECT_EQ(listed, first.size());
+}
+
+// libcamera's own INFO lines (with terminal colours) used to land on stderr at every camera manager start; they
+// go through our log now, where only its warnings and errors are kept.
+TEST(CameraLibcamera, ItsOwnInfoLinesStayOutOfStderr) {
+    testing::internal::CaptureStderr();
+    (void)listLibcameraCameras();
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_EQ(err.find("INFO"), std::string::npos) << err;
+    EXPECT_EQ(err.find("\x1b["), std::string::npos) << err;
 }

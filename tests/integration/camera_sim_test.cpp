@@ -353,14 +353,14 @@ TEST(CameraSim, FactoryOpensTheSimAndAutoFallsBackToItWithoutDevices) {
     settings.simFolder = flatFolder("camera_sim_factory").string();
     settings.simRealTime = false;
     settings.backend = "sim";
-    auto camera = openCamera(settings);
+    auto camera = openReopeningCamera(settings);
     EXPECT_EQ(camera->describe().backend, "sim");
     EXPECT_EQ(camera->nextFrame(1s)->timestamp, 0ns);  // simRealTime = false: a manual clock from 0
     EXPECT_EQ(camera->nextFrame(1s)->timestamp, frameTime(1));
 
     settings.backend = "nonsense";
     try {
-        openCamera(settings);
+        openReopeningCamera(settings);
         FAIL() << "expected a BoothError";
     } catch (const BoothError& e) {
         EXPECT_EQ(e.kind(), ErrorKind::BadConfig);
@@ -371,7 +371,7 @@ TEST(CameraSim, FactoryOpensTheSimAndAutoFallsBackToItWithoutDevices) {
     const auto choice = chooseCameraBackend(settings);
     if (choice.backend != "sim") GTEST_SKIP() << "this machine has a camera: " << choice.reason;
     EXPECT_EQ(choice.reason, "auto: no V4L2 or libcamera camera found, using the simulated camera");
-    camera = openCamera(settings);
+    camera = openReopeningCamera(settings);
     EXPECT_EQ(camera->describe().backend, "sim");
     EXPECT_EQ(camera->describe().note, choice.reason);
     EXPECT_NE(camera->describe().summary().find("using the simulated camera"), std::string::npos);
@@ -390,7 +390,7 @@ TEST(CameraSim, ReplaysTheSyntheticVisitorFolder) {
     settings.simFolder = folder.string();
     settings.simRealTime = false;
     auto controls = std::make_shared<SimCameraControls>();
-    auto camera = openCamera(settings, {controls, nullptr});
+    auto camera = openReopeningCamera(settings, {controls, nullptr});
     const auto d = camera->describe();
     EXPECT_EQ(d.preview.width, 972);  // fits in 1280x720 already: never enlarged
     EXPECT_EQ(d.preview.height, 720);

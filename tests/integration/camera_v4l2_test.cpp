@@ -41,10 +41,11 @@ TEST(CameraV4l2, MissingDeviceIsADeviceErrorNamingIt) {
     EXPECT_EQ(e.where(), "/dev/video99");
     EXPECT_EQ(std::string(e.what()),
               "/dev/video99: no such camera device (is the camera plugged in? `avatarbooth check` lists the cameras)");
-    // Through the factory: the same error, not a fallback.
-    const auto viaFactory = errorFrom([] { openCamera(v4l2("/dev/video99")); });
-    EXPECT_EQ(viaFactory.kind(), ErrorKind::Device);
-    EXPECT_EQ(std::string(viaFactory.what()), std::string(e.what()));
+    // Through the factory (the one way to open a camera, behind reopening): the same error, not a fallback; the
+    // camera starts out lost and says why.
+    const auto viaFactory = openReopeningCamera(v4l2("/dev/video99"));
+    EXPECT_FALSE(viaFactory->status().ok);
+    EXPECT_EQ(viaFactory->status().lastError, std::string(e.what()));
 }
 
 TEST(CameraV4l2, FilesThatAreNoVideoDevicesAreRefused) {

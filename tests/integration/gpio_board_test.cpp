@@ -64,7 +64,7 @@ TEST(GpioBoard, AutoWithoutTheChipRunsTheSimAndSaysWhy) {
     ManualClock clock;
     const SteadyTime t0 = clock.now();
     ButtonBoard board = openButtonBoard(settings, clock);
-    EXPECT_EQ(board.description.rfind(std::string("buttons: sim (auto: GPIO chip \"") + kMissingChip, 0), 0u)
+    EXPECT_EQ(board.description.rfind(std::string("buttons: sim (auto: gpiod: GPIO chip \"") + kMissingChip, 0), 0u)
         << board.description;
     EXPECT_NE(board.description.find("sim timeline " + script.string() + " (18 edges), debounce 30 ms + keyboard: "
                                      "BackSpace=retake Return=start r=retake space=start; lamps: sim lamps"),

@@ -6,6 +6,9 @@
 #include "config/booth_config.h"
 #include "config/config_schema.h"
 #include "common/error.h"
+#include "drivers/camera/camera_backends.h"
+#include "drivers/display/display_backends.h"
+#include "drivers/gpio/button_backends.h"
 
 #include "config_error_of.h"
 
@@ -335,6 +338,31 @@ TEST(Config, MistakesNameFileLineAndKey) {
     EXPECT_EQ(bad.rfind("booth.toml:2: not valid TOML: ", 0), 0u) << bad;
 }
 
+// The words a backend key allows are the device kind's table's names after "auto", nothing written twice.
+TEST(Config, BackendWordsComeFromTheBackendTables) {
+    const auto quotedList = [](const std::vector<std::string>& words) {
+        std::string s;
+        for (std::size_t i = 0; i < words.size(); ++i)
+            s += (i ? (i + 1 == words.size() ? " or \"" : ", \"") : "\"") + words[i] + "\"";
+        return s;
+    };
+    EXPECT_EQ(errorOf("[camera]\nbackend = \"webcam\"\n"),
+              "booth.toml:2: camera.backend: \"webcam\" is not one of " + quotedList(backendWords(cameraBackends())));
+    EXPECT_EQ(errorOf("[buttons]\nbackend = \"wiringpi\"\n"),
+              "booth.toml:2: buttons.backend: \"wiringpi\" is not one of " + quotedList(backendWords(buttonBackends())));
+    EXPECT_EQ(errorOf("[display]\nbackend = \"fbdev\"\n"),
+              "booth.toml:2: display.backend: \"fbdev\" is not one of " + quotedList(backendWords(displayBackends())));
+    EXPECT_EQ(errorOf("[display]\nbackend = \"fbdev\"\n"),
+              "booth.toml:2: display.backend: \"fbdev\" is not one of \"auto\", \"kms\", \"window\" or \"headless\"");
+    for (const ConfigKey& k : configKeys()) {
+        if (k.name != "backend") continue;
+        const std::vector<std::string> table = k.table == "camera"    ? backendWords(cameraBackends())
+                                               : k.table == "buttons" ? backendWords(buttonBackends())
+                                                                      : backendWords(displayBackends());
+        EXPECT_EQ(k.choices, table) << k.table;
+    }
+}
+
 // More broken files, one per kind of check the schema drives: the line named is the offending value's.
 TEST(Config, BrokenFilesNameFileLineAndKey) {
     // Wrong types.
@@ -365,6 +393,31 @@ TEST(Config, BrokenFilesNameFileLineAndKey) {
               "booth.toml:3: camera.reopen_max_delay_s: must not be shorter than reopen_first_delay_s");
     EXPECT_EQ(errorOf("[flow]\nthanks_min_time_s = 30\n"),
               "booth.toml:2: flow.thanks_min_time_s: must not be longer than thanks_time_s");
+}
+
+// Every mistake in the file at once, in the order of the lines (not the schema's), each reading as it does alone.
+TEST(Config, EveryMistakeIsReportedAtOnce) {
+    const std::string text = "[flow]\ncountdown_s = 0.5\n\n[camera]\nsim_real_time = \"yes\"\n\n[display]\nrotation = 360\n";
+    try {
+        parseBoothConfig(text, "booth.toml");
+        FAIL() << "no error";
+    } catch (const ConfigErrors& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::BadConfig);
+        EXPECT_EQ(e.where(), "booth.toml:2");
+        ASSERT_EQ(e.mistakes().size(), 3u) << e.what();
+        EXPECT_STREQ(e.mistakes()[0].what(), "booth.toml:2: flow.countdown_s: must be between 1 and 10, got 0.5");
+        EXPECT_STREQ(e.mistakes()[1].what(), "booth.toml:5: camera.sim_real_time: expected true or false");
+        EXPECT_STREQ(e.mistakes()[2].what(), "booth.toml:8: display.rotation: must be 0, 90, 180 or 270");
+        EXPECT_EQ(std::string(e.what()), std::string(e.mistakes()[0].what()) + "\n" + e.mistakes()[1].what() + "\n" +
+                                             e.mistakes()[2].what());
+    }
+    // Unknown keys are all named, not only the first.
+    EXPECT_EQ(errorOf("[camera]\nbakend = \"sim\"\ndevise = \"/dev/video0\"\n"),
+              "booth.toml:2: camera.bakend: unknown key (see the reference booth.toml for the keys there are)\n"
+              "booth.toml:3: camera.devise: unknown key (see the reference booth.toml for the keys there are)");
+    // A rule across a table's keys is not checked while one of them is wrong: it would blame a key that is right.
+    EXPECT_EQ(errorOf("[camera]\nreopen_first_delay_s = \"10\"\nreopen_max_delay_s = 0.2\n"),
+              "booth.toml:2: camera.reopen_first_delay_s: expected a number");
 }
 
 TEST(Config, DurationsRoundToTheMillisecond) {
