@@ -320,8 +320,7 @@ std::vector<ConfigTable> makeTables() {
     return t;
 }
 
-std::vector<ConfigKey> makeKeys() {
-    std::vector<ConfigKey> k;
+void addFitKeys(std::vector<ConfigKey>& k) {
     // [fit]
     k.push_back(path("fit", "landmark_model", FIELD(fit.settings.landmarkModel),
                      "dlib's 68-point shape predictor (Debian: libdlib-data). It was trained on iBUG 300-W, whose terms "
@@ -342,6 +341,9 @@ std::vector<ConfigKey> makeKeys() {
                         "The avatar's texture, texels per side."));
     k.push_back(integer("fit", "preview_size", FIELD(fit.previewSize), 64, 4096,
                         "The preview renders of a session, pixels per side."));
+}
+
+void addCameraKeys(std::vector<ConfigKey>& k) {
     // [camera]
     k.push_back(backendChoice("camera", FIELD(camera.backend), cameraBackends(),
                               "a V4L2 camera if there is one, else libcamera, else the simulated camera"));
@@ -373,6 +375,9 @@ std::vector<ConfigKey> makeKeys() {
                        "A camera that went away is reopened after this delay, doubling up to reopen_max_delay_s."));
     k.push_back(number("camera", "reopen_max_delay_s", FIELD(camera.reopenMaxDelaySeconds), 0.01, 600.0,
                        "The longest delay between reopening attempts."));
+}
+
+void addButtonsKeys(std::vector<ConfigKey>& k) {
     // [buttons]
     k.push_back(backendChoice("buttons", FIELD(buttons.backend), buttonBackends(),
                               "the GPIO chip when it exists, else simulated"));
@@ -406,6 +411,9 @@ std::vector<ConfigKey> makeKeys() {
                         "The line offset on the chip."));
     k.push_back(flag("buttons.lamp", "active_low", ELEMENT(buttons.lamps[i].activeLow),
                      "The lamp lights with the line low (many relay boards)."));
+}
+
+void addDisplayKeys(std::vector<ConfigKey>& k) {
     // [display]
     k.push_back(backendChoice("display", FIELD(display.backend), displayBackends(),
                               "KMS when a screen is connected, else a window when $DISPLAY is set, else headless"));
@@ -423,6 +431,9 @@ std::vector<ConfigKey> makeKeys() {
                         "headless: write every N-th frame as a PNG into frames_dir (0 = none)."));
     k.push_back(path("display", "frames_dir", FIELD(display.framesDir), "headless: where those frames go."));
     k.push_back(text("display", "window_title", FIELD(display.windowTitle), "window: the window's title."));
+}
+
+void addScreenKeys(std::vector<ConfigKey>& k) {
     // [screen]
     k.push_back(enumChoice(
         "screen", "language", FIELD(screen.language), {"en", "ja"}, [](Language l) { return languageCode(l); },
@@ -437,6 +448,9 @@ std::vector<ConfigKey> makeKeys() {
                      "The screens' strings; \"\" = the strings.toml the booth ships."));
     k.push_back(flag("screen", "start_button_on_left", FIELD(screen.startButtonOnLeft),
                      "The Start (keep) button is left of the Retake button, as the visitor sees them."));
+}
+
+void addFlowKeys(std::vector<ConfigKey>& k) {
     // [flow]
     k.push_back(seconds("flow", "countdown_s", FIELD(flow.countdown), 1.0, 10.0, "Countdown before each photo."));
     k.push_back(seconds("flow", "steady_s", FIELD(flow.steadyOk), 0.0, 10.0,
@@ -470,6 +484,9 @@ std::vector<ConfigKey> makeKeys() {
                         "How long lock_combo is held to open the operator menu."));
     k.push_back(seconds("flow", "operator_timeout_s", FIELD(flow.operatorTimeout), 10.0, 3600.0,
                         "The operator menu closes after this long without a press."));
+}
+
+void addGuidanceKeys(std::vector<ConfigKey>& k) {
     // [guidance.oval]
     k.push_back(number("guidance.oval", "centre_x", FIELD(guidance.oval.centreX), 0.1, 0.9,
                        "The oval's centre, fraction of the frame's width."));
@@ -478,6 +495,9 @@ std::vector<ConfigKey> makeKeys() {
     k.push_back(number("guidance.oval", "height", FIELD(guidance.oval.height), 0.2, 1.0,
                        "The head's outline (hair to chin), fraction of the frame's height."));
     k.push_back(number("guidance.oval", "aspect", FIELD(guidance.oval.aspect), 0.4, 1.2, "The oval's width / height."));
+}
+
+void addSessionsKeys(std::vector<ConfigKey>& k) {
     // [sessions]
     k.push_back(path("sessions", "directory", FIELD(sessions.directory),
                      "Where kept sessions live, one folder per code (created readable by the booth's user only)."));
@@ -487,6 +507,9 @@ std::vector<ConfigKey> makeKeys() {
                                        3650.0, "The whole session is deleted this long after it was kept (0 = never)."));
     k.push_back(integer("sessions", "code_length", FIELD(sessions.codeLength), 4, 12,
                         "Characters in a session's code (the visitor's key to their avatar)."));
+}
+
+void addAnimationKeys(std::vector<ConfigKey>& k) {
     // [animation]
     k.push_back(enumChoice(
         "animation", "style", FIELD(animation.style), {"limited", "full"},
@@ -498,6 +521,9 @@ std::vector<ConfigKey> makeKeys() {
                         "N_io: in-betweens omitted where the motion is fastest."));
     k.push_back(number("animation", "hold_fraction", FIELD(animation.holdFraction), 0.0, 0.9,
                        "N_hf: the share of the frames held."));
+}
+
+void addCharacterKeys(std::vector<ConfigKey>& k) {
     // [character]
     k.push_back(flag("character", "enabled", FIELD(character.enabled),
                      "Make the character in every fit (character.json + character.glb in the session)."));
@@ -512,11 +538,17 @@ std::vector<ConfigKey> makeKeys() {
         "\"photo\": skin and hair colours sampled from the front photo; \"fixed\": the built-in palette."));
     k.push_back(integer("character", "texture_size", FIELD(character.settings.textureSize), 64, 4096,
                         "Edge of the painted (flat-colour) texture in texels."));
+}
+
+void addRevealKeys(std::vector<ConfigKey>& k) {
     // [reveal]
     k.push_back(revealStyles());
     k.push_back(integer("reveal", "toon_colours", FIELD(reveal.toonColours), 2, 16, "Flat colours of the toon drawing."));
     k.push_back(integer("reveal", "toon_strip_frames", FIELD(reveal.toonStripFrames), 2, 360,
                         "Frames of the toon's turntable strip kept in the session (toon/turntable_NNN.png)."));
+}
+
+void addStageKeys(std::vector<ConfigKey>& k) {
     // [stage]
     k.push_back(flag("stage", "enabled", FIELD(stage.enabled), "Show the tile stage under the avatars."));
     k.push_back(path("stage", "map", FIELD(stage.map),
@@ -531,6 +563,22 @@ std::vector<ConfigKey> makeKeys() {
     }
     k.push_back(number("stage", "low_angle_deg", FIELD(stage.lowAngleDeg), 0.0, 44.0,
                        "The camera's elevation in degrees at the ordinary 3-D end of the sweep."));
+}
+
+std::vector<ConfigKey> makeKeys() {
+    std::vector<ConfigKey> k;
+    addFitKeys(k);
+    addCameraKeys(k);
+    addButtonsKeys(k);
+    addDisplayKeys(k);
+    addScreenKeys(k);
+    addFlowKeys(k);
+    addGuidanceKeys(k);
+    addSessionsKeys(k);
+    addAnimationKeys(k);
+    addCharacterKeys(k);
+    addRevealKeys(k);
+    addStageKeys(k);
     return k;
 }
 
