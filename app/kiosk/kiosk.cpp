@@ -10,7 +10,7 @@
 #include "drivers/camera/camera_factory.h"
 #include "drivers/display/display_factory.h"
 #include "drivers/display/headless_egl.h"
-#include "drivers/gpio/clock.h"
+#include "common/clock.h"
 #include "drivers/gpio/lamps.h"
 #include "kiosk/fit_worker.h"
 #include "kiosk/kiosk_figures.h"

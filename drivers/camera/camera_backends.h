@@ -3,7 +3,7 @@
 
 #include "common/backend_table.h"
 #include "drivers/camera/camera.h"
-#include "drivers/camera/camera_clock.h"
+#include "common/clock.h"
 #include "drivers/camera/camera_settings.h"
 #include "drivers/camera/sim_camera.h"
 
@@ -19,7 +19,7 @@ struct CameraEnvironment {
     std::shared_ptr<SimCameraControls> simControls;
     // The clock of the sim camera and of reopen back-off; null: the steady clock, or for a sim camera with
     // simRealTime = false a manual clock starting at 0 (frames as fast as asked).
-    std::shared_ptr<CameraClock> clock;
+    std::shared_ptr<Clock> clock;
 };
 
 // Opens the backend's camera (not yet streaming) on settings.device, with an environment whose controls and clock

@@ -36,9 +36,9 @@ CameraEnvironment completed(const CameraSettings& s, CameraEnvironment env) {
     if (!env.simControls) env.simControls = std::make_shared<SimCameraControls>();
     if (!env.clock) {
         if (s.backend == "sim" && !s.simRealTime)
-            env.clock = std::make_shared<ManualCameraClock>();
+            env.clock = std::make_shared<ManualClock>(SteadyTime{});
         else
-            env.clock = std::make_shared<SteadyCameraClock>();
+            env.clock = std::make_shared<SteadyClock>();
     }
     return env;
 }

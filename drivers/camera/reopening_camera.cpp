@@ -8,10 +8,10 @@
 namespace avatarbooth {
 
 ReopeningCamera::ReopeningCamera(Opener open, std::string label, ReopenPolicy policy,
-                                 std::shared_ptr<CameraClock> clock)
+                                 std::shared_ptr<Clock> clock)
     : open_(std::move(open)), label_(std::move(label)), policy_(policy), clock_(std::move(clock)),
       delay_(policy.firstDelay) {
-    if (!clock_) clock_ = std::make_shared<SteadyCameraClock>();
+    if (!clock_) clock_ = std::make_shared<SteadyClock>();
     try {
         camera_ = open_();
         everOpened_ = true;

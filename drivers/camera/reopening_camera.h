@@ -3,7 +3,7 @@
 #pragma once
 
 #include "drivers/camera/camera.h"
-#include "drivers/camera/camera_clock.h"
+#include "common/clock.h"
 
 #include <chrono>
 #include <functional>
@@ -37,7 +37,7 @@ public:
     // throw: the camera starts out lost and is retried; other errors (bad configuration, bad sim folder) do.
     // `label` names the camera in messages (e.g. "/dev/video0").
     ReopeningCamera(Opener open, std::string label, ReopenPolicy policy = {},
-                    std::shared_ptr<CameraClock> clock = nullptr);
+                    std::shared_ptr<Clock> clock = nullptr);
 
     void start() override;
     // While the camera is lost, waits (up to the timeout) for the next retry and returns nullopt if it fails.
@@ -61,12 +61,12 @@ private:
     Opener open_;
     std::string label_;
     ReopenPolicy policy_;
-    std::shared_ptr<CameraClock> clock_;
+    std::shared_ptr<Clock> clock_;
     std::unique_ptr<Camera> camera_;
     bool everOpened_ = false;
     bool wantStreaming_ = false;
     std::chrono::nanoseconds delay_;
-    std::chrono::nanoseconds nextRetry_{0};
+    SteadyTime nextRetry_{};
     std::uint64_t sequenceBase_ = 0;
     std::uint64_t nextSequence_ = 0;  // one after the last frame delivered
     CameraDescription lastDescription_;

@@ -114,11 +114,11 @@ std::chrono::nanoseconds SimCameraControls::takeDelay() {
 }
 
 SimCamera::SimCamera(SimCameraOptions options, std::shared_ptr<SimCameraControls> controls,
-                     std::shared_ptr<CameraClock> clock)
+                     std::shared_ptr<Clock> clock)
     : options_(std::move(options)), controls_(std::move(controls)), clock_(std::move(clock)),
       label_("sim:" + options_.folder.string()) {
     if (!controls_) controls_ = std::make_shared<SimCameraControls>();
-    if (!clock_) clock_ = std::make_shared<SteadyCameraClock>();
+    if (!clock_) clock_ = std::make_shared<SteadyClock>();
     if (!(options_.fps > 0)) throw BoothError(ErrorKind::BadConfig, "", "sim camera: the frame rate must be positive");
     if (options_.previewWidth <= 0 || options_.previewHeight <= 0)
         throw BoothError(ErrorKind::BadConfig, "", "sim camera: the preview size must be positive");
@@ -152,7 +152,7 @@ void SimCamera::checkConnected() {
     if (gone_) throw CameraGoneError(label_, "simulated unplug");
 }
 
-std::chrono::nanoseconds SimCamera::dueTime(std::uint64_t index) const {
+SteadyTime SimCamera::dueTime(std::uint64_t index) const {
     return streamStart_ + std::chrono::nanoseconds(std::llround(static_cast<double>(index) * 1e9 / options_.fps));
 }
 
@@ -191,7 +191,7 @@ std::optional<CameraFrame> SimCamera::nextFrame(std::chrono::milliseconds timeou
 
     CameraFrame frame;
     frame.sequence = streamFirstSequence_ + index;
-    frame.timestamp = due;
+    frame.timestamp = std::chrono::duration_cast<std::chrono::nanoseconds>(due.time_since_epoch());
     frame.image = previews_[static_cast<std::size_t>(controls_->scene())].clone();
     noise_.apply(frame.image, options_.noiseSeed ^ (frame.sequence * 0xD1B54A32D192ED03ull));
     if (controls_->takeCorruption())
@@ -205,7 +205,7 @@ CameraFrame SimCamera::captureStill() {
     CameraFrame frame;
     frame.image = stills_[static_cast<std::size_t>(controls_->scene())].clone();
     frame.sequence = stillsTaken_++;
-    frame.timestamp = clock_->now();
+    frame.timestamp = std::chrono::duration_cast<std::chrono::nanoseconds>(clock_->now().time_since_epoch());
     return frame;
 }
 

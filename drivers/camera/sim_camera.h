@@ -3,7 +3,7 @@
 #pragma once
 
 #include "drivers/camera/camera.h"
-#include "drivers/camera/camera_clock.h"
+#include "common/clock.h"
 
 #include <opencv2/core.hpp>
 
@@ -93,7 +93,7 @@ public:
     // Reads the folder's images. Throws BoothError(BadInput) naming the folder or the file when the folder, a
     // front or side photo is missing, or an image is empty or does not decode; CameraGoneError when the
     // controls say the camera is unplugged.
-    SimCamera(SimCameraOptions options, std::shared_ptr<SimCameraControls> controls, std::shared_ptr<CameraClock> clock);
+    SimCamera(SimCameraOptions options, std::shared_ptr<SimCameraControls> controls, std::shared_ptr<Clock> clock);
 
     void start() override;
     std::optional<CameraFrame> nextFrame(std::chrono::milliseconds timeout) override;
@@ -108,18 +108,18 @@ public:
 
 private:
     void checkConnected();
-    std::chrono::nanoseconds dueTime(std::uint64_t index) const;
+    SteadyTime dueTime(std::uint64_t index) const;
 
     SimCameraOptions options_;
     std::shared_ptr<SimCameraControls> controls_;
-    std::shared_ptr<CameraClock> clock_;
+    std::shared_ptr<Clock> clock_;
     std::string label_;
     std::array<cv::Mat, 3> stills_;    // by SimScene
     std::array<cv::Mat, 3> previews_;  // by SimScene, all of the preview size
     SensorNoise noise_;
     bool gone_ = false;
     bool streaming_ = false;
-    std::chrono::nanoseconds streamStart_{0};
+    SteadyTime streamStart_{};
     std::uint64_t streamFirstSequence_ = 0;  // sequence of the stream's frame 0
     std::uint64_t nextIndex_ = 0;            // within the stream
     std::uint64_t stillsTaken_ = 0;

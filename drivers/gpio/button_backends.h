@@ -3,7 +3,7 @@
 
 #include "common/backend_table.h"
 #include "drivers/gpio/buttons.h"
-#include "drivers/gpio/clock.h"
+#include "common/clock.h"
 #include "drivers/gpio/gpio_settings.h"
 #include "drivers/gpio/lamps.h"
 

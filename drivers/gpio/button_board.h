@@ -3,7 +3,7 @@
 
 #include "drivers/gpio/button_backends.h"
 #include "drivers/gpio/buttons.h"
-#include "drivers/gpio/clock.h"
+#include "common/clock.h"
 #include "drivers/gpio/debouncer.h"
 #include "drivers/gpio/gpio_settings.h"
 #include "drivers/gpio/keyboard_buttons.h"

@@ -12,7 +12,7 @@
 // is an error. Errors name the file, the line and what is wrong (BoothError BadConfig).
 #pragma once
 
-#include "drivers/gpio/clock.h"
+#include "common/clock.h"
 #include "drivers/gpio/raw_lines.h"
 
 #include <chrono>

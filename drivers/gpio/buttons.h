@@ -1,7 +1,7 @@
 // Buttons: press and release events from arcade buttons (GPIO), a scripted timeline (sim) or a keyboard.
 #pragma once
 
-#include "drivers/gpio/clock.h"
+#include "common/clock.h"
 
 #include <chrono>
 #include <optional>

@@ -1,7 +1,7 @@
 // Debouncing of one button line: raw edges in, clean press/release transitions out. Pure logic, time injected.
 #pragma once
 
-#include "drivers/gpio/clock.h"
+#include "common/clock.h"
 
 #include <chrono>
 #include <optional>

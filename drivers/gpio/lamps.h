@@ -1,7 +1,7 @@
 // Lamps: the button lamps and the flash, switched on and off by name; patterns (blink, flash) as pure logic.
 #pragma once
 
-#include "drivers/gpio/clock.h"
+#include "common/clock.h"
 #include "drivers/gpio/raw_lines.h"
 
 #include <chrono>

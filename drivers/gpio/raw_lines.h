@@ -3,7 +3,7 @@
 // naming and event order are written once (DebouncedButtons, LineLamps).
 #pragma once
 
-#include "drivers/gpio/clock.h"
+#include "common/clock.h"
 
 #include <cstddef>
 #include <string>

@@ -81,7 +81,7 @@ void simPreviewFrame720p(benchmark::State& state) {
     SimCameraOptions options;
     options.folder = dir;
     options.fps = 1e6;  // never waits: measures the frame's own cost
-    SimCamera camera(options, nullptr, std::make_shared<ManualCameraClock>());
+    SimCamera camera(options, nullptr, std::make_shared<ManualClock>(SteadyTime{}));
     for (auto _ : state) benchmark::DoNotOptimize(camera.nextFrame(std::chrono::milliseconds(100)));
     state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
     std::filesystem::remove_all(dir);

@@ -22,7 +22,7 @@ TEST(CameraSimData, RealPhotosPreviewSmallerAndCaptureAtFullSize) {
     auto controls = std::make_shared<SimCameraControls>();
     SimCameraOptions options;
     options.folder = folder;
-    SimCamera camera(options, controls, std::make_shared<ManualCameraClock>());
+    SimCamera camera(options, controls, std::make_shared<ManualClock>(SteadyTime{}));
     const auto d = camera.describe();
     EXPECT_EQ(d.preview.width, 1280);
     EXPECT_EQ(d.preview.height, 720);

@@ -76,7 +76,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         options.previewHeight = 120;
         options.noise = 2;
         auto controls = std::make_shared<SimCameraControls>();
-        SimCamera camera(options, controls, std::make_shared<ManualCameraClock>());
+        SimCamera camera(options, controls, std::make_shared<ManualClock>(SteadyTime{}));
         camera.start();
         for (const auto scene : {SimScene::Empty, SimScene::Front, SimScene::Side}) {
             controls->setScene(scene);

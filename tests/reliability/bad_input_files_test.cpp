@@ -50,7 +50,7 @@ SimCamera openSim(const fs::path& folder) {
     o.folder = folder;
     o.previewWidth = 160;
     o.previewHeight = 120;
-    return SimCamera(o, std::make_shared<SimCameraControls>(), std::make_shared<ManualCameraClock>());
+    return SimCamera(o, std::make_shared<SimCameraControls>(), std::make_shared<ManualClock>(SteadyTime{}));
 }
 
 }  // namespace

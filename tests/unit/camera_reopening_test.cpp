@@ -17,7 +17,7 @@ struct FakeWorld {
     bool misconfigured = false;
     std::vector<std::chrono::nanoseconds> openTimes;  // when each open was attempted
     int starts = 0;
-    std::shared_ptr<ManualCameraClock> clock = std::make_shared<ManualCameraClock>();
+    std::shared_ptr<ManualClock> clock = std::make_shared<ManualClock>(SteadyTime{});
 };
 
 // Frames every 10 ms from its own sequence 0; throws CameraGoneError once the world unplugs it.
@@ -31,11 +31,11 @@ public:
     std::optional<CameraFrame> nextFrame(std::chrono::milliseconds) override {
         check();
         world_.clock->advance(10ms);
-        return CameraFrame{cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(1)), next_++, world_.clock->now()};
+        return CameraFrame{cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(1)), next_++, world_.clock->now().time_since_epoch()};
     }
     CameraFrame captureStill() override {
         check();
-        return CameraFrame{cv::Mat(2, 2, CV_8UC3, cv::Scalar::all(2)), 0, world_.clock->now()};
+        return CameraFrame{cv::Mat(2, 2, CV_8UC3, cv::Scalar::all(2)), 0, world_.clock->now().time_since_epoch()};
     }
     void stop() override {}
     CameraDescription describe() const override { return {"fake", "/dev/fake", "fake camera", {}, {}, ""}; }
@@ -50,7 +50,7 @@ private:
 
 std::unique_ptr<ReopeningCamera> makeCamera(FakeWorld& world) {
     auto open = [&world]() -> std::unique_ptr<Camera> {
-        world.openTimes.push_back(world.clock->now());
+        world.openTimes.push_back(world.clock->now().time_since_epoch());
         if (world.misconfigured) throw BoothError(ErrorKind::BadConfig, "camera.device", "not a camera path");
         if (!world.present) throw BoothError(ErrorKind::Device, "/dev/fake", "no such camera device");
         return std::make_unique<FakeCamera>(world);
@@ -78,7 +78,7 @@ TEST(CameraReopening, RetriesWithDoublingDelaysAndResumesWhenTheCameraComesBack)
     FakeWorld world;
     auto camera = makeCamera(world);
     for (int i = 0; i < 5; ++i) ASSERT_TRUE(camera->nextFrame(100ms));  // sequences 0..4, clock at 50 ms
-    ASSERT_EQ(world.clock->now(), 50ms);
+    ASSERT_EQ(world.clock->now().time_since_epoch(), 50ms);
 
     world.present = false;
     EXPECT_FALSE(camera->nextFrame(100ms));  // lost at 50 ms; first retry due at 550 ms
@@ -88,11 +88,11 @@ TEST(CameraReopening, RetriesWithDoublingDelaysAndResumesWhenTheCameraComesBack)
     EXPECT_EQ(status.lastError, "camera /dev/fake disconnected (ENODEV)");
     EXPECT_EQ(camera->current(), nullptr);
     EXPECT_EQ(camera->describe().note, "camera /dev/fake disconnected, retrying");
-    EXPECT_EQ(world.clock->now(), 150ms);  // waited out its timeout
+    EXPECT_EQ(world.clock->now().time_since_epoch(), 150ms);  // waited out its timeout
 
     // Keep asking for frames for 20 s of camera time: retries at 0.55, 1.55, 3.55, 7.55, 11.55, 15.55, 19.55 s
     // (delays 0.5, 1, 2, 4, then capped at 4).
-    while (world.clock->now() < 20s) EXPECT_FALSE(camera->nextFrame(250ms));
+    while (world.clock->now().time_since_epoch() < 20s) EXPECT_FALSE(camera->nextFrame(250ms));
     const std::vector<std::chrono::nanoseconds> expected{0ms, 550ms, 1550ms, 3550ms, 7550ms, 11550ms, 15550ms, 19550ms};
     EXPECT_EQ(world.openTimes, expected);
     EXPECT_EQ(camera->status().failedReopens, 7);
@@ -119,8 +119,8 @@ TEST(CameraReopening, BackOffStartsAgainAfterARecovery) {
     for (int round = 0; round < 2; ++round) {
         world.present = false;
         world.openTimes.clear();
-        const auto lostAt = world.clock->now();
-        while (world.clock->now() < lostAt + 2s) camera->nextFrame(100ms);
+        const auto lostAt = world.clock->now().time_since_epoch();
+        while (world.clock->now().time_since_epoch() < lostAt + 2s) camera->nextFrame(100ms);
         world.present = true;
         while (!camera->nextFrame(100ms)) {
         }
