@@ -2,9 +2,8 @@
 //
 // Opens EGL through Mesa's surfaceless platform (EGL_PLATFORM_SURFACELESS_MESA) and falls back to device
 // enumeration (EGL_EXT_device_enumeration + EGL_EXT_platform_device). The context is made current without a
-// surface (EGL_KHR_surfaceless_context), so all drawing goes to framebuffer objects. The GBM/KMS and the window
-// displays will sit beside this class; EGL types stay out of this header so including it pulls in no EGL/X11
-// headers.
+// surface (EGL_KHR_surfaceless_context), so all drawing goes to framebuffer objects. EGL types stay out of this
+// header so including it pulls in no EGL/X11 headers.
 #pragma once
 
 #include <string>
