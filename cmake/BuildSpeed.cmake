@@ -1,7 +1,7 @@
-# Build-time savings for CI's budget (preset "ci", and "arm64" which inherits it): precompiled third-party headers.
-# They matter on a machine with no compiler cache, where every build is from scratch; with ccache (developers'
-# builds) a precompiled header mostly gets in the way of cache hits, so the option is off unless a preset sets it.
-# Measured figures are in tests/run.sh.
+# Build-time savings for a build from scratch (the presets "release", which the README's two commands use, "ci" and
+# "arm64"): precompiled third-party headers, made once for the first of the booth's libraries and reused by the
+# others. With ccache a precompiled header mostly gets in the way of cache hits: a developer with a compiler cache
+# configures with -DAVATARBOOTH_PCH=OFF. The README ("The two commands", "Building for the board") has the figures.
 option(AVATARBOOTH_PCH "Precompile the third-party headers most sources include (OpenCV, JSON, spdlog, GoogleTest)"
        OFF)
 

@@ -3,14 +3,15 @@
 # apt-get), installs from npm the glTF validator (tests/gltf/), the batch report's 3-D viewer (app/assets/report/)
 # and the browser driver of the report test (tests/browser/), and builds the project with CMake.
 # Usage: tests/setup.sh [PRESET] [TARGET...]   (default: release; CI uses "ci", which turns warnings into errors)
-# With TARGETs (sim/demo.sh passes avatarbooth) only those are built and the npm packages of the tests are left out;
-# without, everything is built (the tests, the benchmarks).
+# With TARGETs (sim/demo.sh passes avatarbooth) only those are built, and the tests' Debian and npm packages are
+# left out; without, everything is installed and built (the tests, the benchmarks).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 preset="${1:-release}"
 shift || true
 targets=("$@")
 
+# What building and running the booth needs (sim/demo.sh installs these alone) ...
 packages=(
   build-essential cmake pkg-config git
   libopencv-dev opencv-data libdlib-dev libdlib-data
@@ -20,8 +21,12 @@ packages=(
   libfreetype-dev fonts-dejavu-core fonts-vlgothic
   # image files (app/common/image_codec): libjpeg-turbo, libpng, libexif (orientation), stb_image (BMP)
   libjpeg-dev libpng-dev libexif-dev libstb-dev zlib1g-dev
+  # (the build's configuration looks for the test and benchmark libraries)
   libgtest-dev libgmock-dev libbenchmark-dev
   systemd device-tree-compiler
+)
+# ... and what the tests need besides.
+test_packages=(
   nodejs npm
   # the batch report test opens report.html in headless Chromium (driven by puppeteer-core from npm)
   chromium
@@ -36,6 +41,7 @@ packages=(
   # sysroot; listed here too so that a fresh machine installs everything in one apt-get run
   g++-aarch64-linux-gnu qemu-user mmdebstrap
 )
+((${#targets[@]})) || packages+=("${test_packages[@]}")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
