@@ -56,9 +56,11 @@ ConfigKey choice(std::string table, std::string name, Ref ref, std::vector<std::
 
 // A device kind's `backend` key: the words are the kind's backend table's names after "auto" (so the file accepts
 // exactly what the factories open), and the doc lists them after what "auto" does.
-template <typename Ref, typename Entry>
-ConfigKey backendChoice(std::string table, Ref ref, std::span<const Entry> backends, const std::string& autoDoes) {
-    std::vector<std::string> words = backendWords(backends);
+template <typename Ref, std::size_t N>
+ConfigKey backendChoice(std::string table, Ref ref, const std::array<std::string_view, N>& backends,
+                        const std::string& autoDoes) {
+    std::vector<std::string> words{"auto"};
+    for (const std::string_view name : backends) words.emplace_back(name);
     std::string doc = "\"auto\" (" + autoDoes + ")";
     for (std::size_t i = 1; i < words.size(); ++i) doc += ", \"" + words[i] + "\"";
     return choice(std::move(table), "backend", ref, std::move(words), doc + ".");
@@ -345,7 +347,7 @@ void addFitKeys(std::vector<ConfigKey>& k) {
 
 void addCameraKeys(std::vector<ConfigKey>& k) {
     // [camera]
-    k.push_back(backendChoice("camera", FIELD(camera.backend), cameraBackends(),
+    k.push_back(backendChoice("camera", FIELD(camera.backend), kCameraBackendNames,
                               "a V4L2 camera if there is one, else libcamera, else the simulated camera"));
     k.push_back(text("camera", "device", FIELD(camera.device),
                      "v4l2: \"/dev/video0\" or a stable /dev/v4l/by-id/... name; libcamera: the camera id from "
@@ -379,7 +381,7 @@ void addCameraKeys(std::vector<ConfigKey>& k) {
 
 void addButtonsKeys(std::vector<ConfigKey>& k) {
     // [buttons]
-    k.push_back(backendChoice("buttons", FIELD(buttons.backend), buttonBackends(),
+    k.push_back(backendChoice("buttons", FIELD(buttons.backend), kButtonBackendNames,
                               "the GPIO chip when it exists, else simulated"));
     k.push_back(text("buttons", "chip", FIELD(buttons.chip),
                      "The GPIO chip by label (\"pinctrl-bcm2711\"), name (\"gpiochip0\"), path or number."));
@@ -415,7 +417,7 @@ void addButtonsKeys(std::vector<ConfigKey>& k) {
 
 void addDisplayKeys(std::vector<ConfigKey>& k) {
     // [display]
-    k.push_back(backendChoice("display", FIELD(display.backend), displayBackends(),
+    k.push_back(backendChoice("display", FIELD(display.backend), kDisplayBackendNames,
                               "KMS when a screen is connected, else a window when $DISPLAY is set, else headless"));
     k.push_back(integer("display", "rotation", FIELD(display.rotation), 0, 270,
                         "Degrees the picture is turned clockwise for the panel (portrait panels: 90 or 270).", 90));

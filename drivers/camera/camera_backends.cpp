@@ -63,12 +63,14 @@ std::unique_ptr<Camera> openSim(const CameraSettings& s, const CameraEnvironment
 }
 
 constexpr CameraBackend kCameraBackends[] = {
-    {"v4l2", probeV4l2, openV4l2},
-    {"libcamera", probeLibcamera, openLibcamera},
-    {"sim", probeSim, openSim},
+    {kCameraBackendNames[0], probeV4l2, openV4l2},
+    {kCameraBackendNames[1], probeLibcamera, openLibcamera},
+    {kCameraBackendNames[2], probeSim, openSim},
 };
 
 }  // namespace
+
+static_assert(std::size(kCameraBackends) == kCameraBackendNames.size(), "a name for every row");
 
 std::span<const CameraBackend> cameraBackends() { return kCameraBackends; }
 

@@ -8,7 +8,9 @@
 #include "drivers/camera/sim_camera.h"
 
 #include <memory>
+#include <array>
 #include <span>
+#include <string_view>
 
 namespace avatarbooth {
 
@@ -29,6 +31,9 @@ using CameraBackend = Backend<CameraSettings, OpenCamera>;
 
 // v4l2 (a node offering a format we read; settings.device a /dev/ name or ""), libcamera (settings.device a camera
 // id or ""), sim (always usable). The probes look without streaming and never throw.
+// The table's names in its order: the words the configuration accepts after "auto" (read without the table, so
+// that the configuration needs none of the drivers).
+inline constexpr std::array<std::string_view, 3> kCameraBackendNames{"v4l2", "libcamera", "sim"};
 std::span<const CameraBackend> cameraBackends();
 
 }  // namespace avatarbooth

@@ -34,12 +34,14 @@ std::unique_ptr<Display> openWindow(const DisplaySettings& s) { return std::make
 std::unique_ptr<Display> openHeadless(const DisplaySettings& s) { return std::make_unique<HeadlessDisplay>(s); }
 
 constexpr DisplayBackend kDisplayBackends[] = {
-    {"kms", probeKms, openKms},
-    {"window", probeWindow, openWindow},
-    {"headless", probeHeadless, openHeadless},
+    {kDisplayBackendNames[0], probeKms, openKms},
+    {kDisplayBackendNames[1], probeWindow, openWindow},
+    {kDisplayBackendNames[2], probeHeadless, openHeadless},
 };
 
 }  // namespace
+
+static_assert(std::size(kDisplayBackends) == kDisplayBackendNames.size(), "a name for every row");
 
 std::span<const DisplayBackend> displayBackends() { return kDisplayBackends; }
 

@@ -69,11 +69,13 @@ OpenedButtons openSim(const GpioSettings& settings, Clock& clock) {
 }
 
 constexpr ButtonBackend kButtonBackends[] = {
-    {"gpiod", probeGpiod, openGpiod},
-    {"sim", probeSim, openSim},
+    {kButtonBackendNames[0], probeGpiod, openGpiod},
+    {kButtonBackendNames[1], probeSim, openSim},
 };
 
 }  // namespace
+
+static_assert(std::size(kButtonBackends) == kButtonBackendNames.size(), "a name for every row");
 
 std::span<const ButtonBackend> buttonBackends() { return kButtonBackends; }
 

@@ -8,7 +8,9 @@
 #include "drivers/gpio/lamps.h"
 
 #include <memory>
+#include <array>
 #include <span>
+#include <string_view>
 
 namespace avatarbooth {
 
@@ -25,6 +27,9 @@ using OpenButtons = OpenedButtons (*)(const GpioSettings& settings, Clock& clock
 using ButtonBackend = Backend<GpioSettings, OpenButtons>;
 
 // gpiod (usable when the chip opens; no line is requested by the probe), sim (always usable).
+// The table's names in its order: the words the configuration accepts after "auto" (read without the table, so
+// that the configuration needs none of the drivers).
+inline constexpr std::array<std::string_view, 2> kButtonBackendNames{"gpiod", "sim"};
 std::span<const ButtonBackend> buttonBackends();
 
 }  // namespace avatarbooth
