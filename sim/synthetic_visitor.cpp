@@ -100,58 +100,50 @@ cv::Mat paintSyntheticFace(const BaseHead& base, int textureSize) {
     const cv::Vec3d skin(128, 158, 206), skinShadow(110, 135, 185), hair(28, 38, 58), brow(35, 45, 65);
     const cv::Vec3d sclera(222, 228, 232), iris(55, 85, 120), pupil(18, 18, 22), lash(25, 25, 35);
     const cv::Vec3d lip(92, 92, 172), lipLine(45, 45, 95), nostril(40, 50, 85);
-    cv::Mat texture(textureSize, textureSize, CV_8UC3, cv::Scalar(0, 0, 0));
     std::mt19937 rng(7);
     std::normal_distribution<double> grain(0.0, 3.0);
-    for (int y = 0; y < textureSize; ++y) {
-        for (int x = 0; x < textureSize; ++x) {
-            if (!texels.covered.at<unsigned char>(y, x)) continue;
-            const cv::Vec3f pf = texels.position.at<cv::Vec3f>(y, x);
-            const cv::Vec3f nf = texels.normal.at<cv::Vec3f>(y, x);
-            const glm::dvec3 p(pf[0], pf[1], pf[2]);
-            const glm::dvec2 q(p.x, p.y);
-            const bool onFace = p.z > faceDepth && nf[2] > 0.25;
-            // Skin with a gentle low-frequency variation (blotches) so the surface is not flat colour.
-            cv::Vec3d colour = mix(skin, skinShadow, 0.5 + 0.5 * std::sin(p.x * 0.09) * std::sin(p.y * 0.07 + p.z * 0.05));
-            const double azimuth = std::atan2(p.x, p.z) * 180.0 / kPi;
-            const bool ear = std::abs(p.x) > 70.0 && p.y > -40.0 && p.y < 28.0 && p.z > -30.0 && p.z < 14.0;
-            const double hairTop = hairlineHeight(azimuth);
-            if (!ear && p.y > hairTop) colour = mix(colour, hair, std::min(1.0, (p.y - hairTop) / 4.0));
-            if (onFace) {
-                // Brows: a thick stroke along 17-21 and 22-26.
-                for (const int start : {17, 22})
-                    for (int k = start; k < start + 4; ++k)
-                        if (distanceToSegment(q, xy(at(k)), xy(at(k + 1))) < 3.2) colour = brow;
-                // Eyes: an almond of the eye's width, iris, pupil, lash line on the upper lid.
-                for (const glm::dvec3& eye : {rightEye, leftEye}) {
-                    const glm::dvec2 d = (q - xy(eye)) / eyeHalfWidth;
-                    const double lidHeight = d.y > 0 ? 0.42 : 0.36;
-                    const double almond = d.x * d.x + (d.y / lidHeight) * (d.y / lidHeight);
-                    if (almond < 1.0) {
-                        const double r = glm::length(q - xy(eye));
-                        colour = r < 2.4 ? pupil : (r < 5.6 ? iris : sclera);
-                    } else if (almond < 1.45 && d.y > 0.0) {
-                        colour = lash;
-                    } else if (almond < 1.6 && d.y <= 0.0) {
-                        colour = mix(colour, skinShadow * 0.8, 0.6);
-                    }
-                }
-                // Lips: an ellipse around the mouth, a dark line between them.
-                const glm::dvec2 m = (q - xy(mouth)) / mouthHalfWidth;
-                const double lipEllipse = m.x * m.x + (m.y / 0.42) * (m.y / 0.42);
-                if (lipEllipse < 1.0) colour = std::abs(m.y) < 0.05 ? lipLine : lip;
-                // Nostrils under the nose tip, either side of 33.
-                for (const double side : {-1.0, 1.0}) {
-                    const glm::dvec2 n = q - (xy(at(33)) + glm::dvec2(side * 7.0, 1.5));
-                    if ((n.x / 3.6) * (n.x / 3.6) + (n.y / 2.0) * (n.y / 2.0) < 1.0) colour = nostril;
+    cv::Mat texture = paintTexels(texels, [&](const glm::dvec3& p, const cv::Vec3f& nf) {
+        const glm::dvec2 q(p.x, p.y);
+        const bool onFace = p.z > faceDepth && nf[2] > 0.25;
+        // Skin with a gentle low-frequency variation (blotches) so the surface is not flat colour.
+        cv::Vec3d colour = mix(skin, skinShadow, 0.5 + 0.5 * std::sin(p.x * 0.09) * std::sin(p.y * 0.07 + p.z * 0.05));
+        const double azimuth = std::atan2(p.x, p.z) * 180.0 / kPi;
+        const bool ear = std::abs(p.x) > 70.0 && p.y > -40.0 && p.y < 28.0 && p.z > -30.0 && p.z < 14.0;
+        const double hairTop = hairlineHeight(azimuth);
+        if (!ear && p.y > hairTop) colour = mix(colour, hair, std::min(1.0, (p.y - hairTop) / 4.0));
+        if (onFace) {
+            // Brows: a thick stroke along 17-21 and 22-26.
+            for (const int start : {17, 22})
+                for (int k = start; k < start + 4; ++k)
+                    if (distanceToSegment(q, xy(at(k)), xy(at(k + 1))) < 3.2) colour = brow;
+            // Eyes: an almond of the eye's width, iris, pupil, lash line on the upper lid.
+            for (const glm::dvec3& eye : {rightEye, leftEye}) {
+                const glm::dvec2 d = (q - xy(eye)) / eyeHalfWidth;
+                const double lidHeight = d.y > 0 ? 0.42 : 0.36;
+                const double almond = d.x * d.x + (d.y / lidHeight) * (d.y / lidHeight);
+                if (almond < 1.0) {
+                    const double r = glm::length(q - xy(eye));
+                    colour = r < 2.4 ? pupil : (r < 5.6 ? iris : sclera);
+                } else if (almond < 1.45 && d.y > 0.0) {
+                    colour = lash;
+                } else if (almond < 1.6 && d.y <= 0.0) {
+                    colour = mix(colour, skinShadow * 0.8, 0.6);
                 }
             }
-            const double g = grain(rng);
-            texture.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<unsigned char>(colour[0] + g),
-                                                    cv::saturate_cast<unsigned char>(colour[1] + g),
-                                                    cv::saturate_cast<unsigned char>(colour[2] + g));
+            // Lips: an ellipse around the mouth, a dark line between them.
+            const glm::dvec2 m = (q - xy(mouth)) / mouthHalfWidth;
+            const double lipEllipse = m.x * m.x + (m.y / 0.42) * (m.y / 0.42);
+            if (lipEllipse < 1.0) colour = std::abs(m.y) < 0.05 ? lipLine : lip;
+            // Nostrils under the nose tip, either side of 33.
+            for (const double side : {-1.0, 1.0}) {
+                const glm::dvec2 n = q - (xy(at(33)) + glm::dvec2(side * 7.0, 1.5));
+                if ((n.x / 3.6) * (n.x / 3.6) + (n.y / 2.0) * (n.y / 2.0) < 1.0) colour = nostril;
+            }
         }
-    }
+        const double g = grain(rng);
+        return cv::Vec3b(cv::saturate_cast<unsigned char>(colour[0] + g), cv::saturate_cast<unsigned char>(colour[1] + g),
+                         cv::saturate_cast<unsigned char>(colour[2] + g));
+    });
     padTextureBorders(texture, texels.covered, 6);
     cv::GaussianBlur(texture, texture, cv::Size(3, 3), 0.8);
     return texture;

@@ -30,6 +30,21 @@ SurfaceTexels sampleSurfaceTexels(const Mesh& mesh, const std::vector<glm::dvec3
 // positions and the given per-vertex normals barycentrically.
 SurfaceTexels sampleSurfaceTexels(const Mesh& mesh, const std::vector<glm::dvec3>& normals, cv::Size size);
 
+// A texture painted texel by texel (BGR, the texels' size): `paint(position, normal)` gives the colour of each
+// covered texel, in row order; the others stay black. The procedural textures (the character's flat colours, the
+// synthetic visitor's face) are painted so.
+template <typename Paint>
+cv::Mat paintTexels(const SurfaceTexels& texels, Paint&& paint) {
+    cv::Mat texture(texels.covered.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+    for (int y = 0; y < texture.rows; ++y)
+        for (int x = 0; x < texture.cols; ++x) {
+            if (!texels.covered.at<unsigned char>(y, x)) continue;
+            const cv::Vec3f pf = texels.position.at<cv::Vec3f>(y, x);
+            texture.at<cv::Vec3b>(y, x) = paint(glm::dvec3(pf[0], pf[1], pf[2]), texels.normal.at<cv::Vec3f>(y, x));
+        }
+    return texture;
+}
+
 // Extends the colours of covered texels a few texels into the uncovered ones, so that mipmapping and bilinear
 // filtering never pull in the empty background along UV borders.
 void padTextureBorders(cv::Mat& textureBgr, const cv::Mat& covered, int texels = 4);

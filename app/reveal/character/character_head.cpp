@@ -301,60 +301,53 @@ cv::Mat paintCharacterTexture(const BaseHead& base, int textureSize, const Chara
     const cv::Vec3b white(250, 250, 250), ink(30, 25, 30), brow = colour(look.hair * 0.7);
     const cv::Vec3b blush = colour(look.skin * 0.6 + cv::Scalar(90, 90, 255) * 0.4), mouthLine = colour(look.lips * 0.55);
 
-    cv::Mat texture(textureSize, textureSize, CV_8UC3, cv::Scalar(0, 0, 0));
-    for (int y = 0; y < textureSize; ++y) {
-        for (int x = 0; x < textureSize; ++x) {
-            if (!texels.covered.at<unsigned char>(y, x)) continue;
-            const cv::Vec3f pf = texels.position.at<cv::Vec3f>(y, x);
-            const cv::Vec3f nf = texels.normal.at<cv::Vec3f>(y, x);
-            const glm::dvec3 p(pf[0], pf[1], pf[2]);
-            const glm::dvec2 q(p.x, p.y);
-            cv::Vec3b c = skin;
-            // Hair: a cap whose edge is high on the forehead, comes down over the temples above the ears and to the
-            // nape at the back (by the direction around the head, 0 = the face).
-            const double azimuth = std::abs(std::atan2(p.x, p.z)) * 180.0 / kPi;
-            const double front = browLine + 0.75 * eyeDistance, temple = browLine - 0.05 * eyeDistance,
-                         back = browLine - 1.2 * eyeDistance;
-            const double hairline = azimuth < 30.0 ? front
-                              : azimuth < 80.0 ? front + (temple - front) * (azimuth - 30.0) / 50.0
-                              : azimuth < 120.0 ? temple
-                              : azimuth < 160.0 ? temple + (back - temple) * (azimuth - 120.0) / 40.0
-                                                : back;
-            const bool ear = std::abs(p.x) > earX && p.y < browLine && p.y > browLine - 1.3 * eyeDistance &&
-                             p.z > -0.55 * eyeDistance && p.z < 0.3 * eyeDistance;
-            if (!ear && p.y > hairline) c = hair;
-            if (p.z > faceDepth && nf[2] > 0.2f) {
-                for (std::size_t side = 0; side < 2; ++side) {
-                    // Blush under each eye.
-                    const glm::dvec2 cheek = eyes[side] + glm::dvec2(side == 0 ? -0.05 : 0.05, -0.55) * eyeDistance;
-                    const glm::dvec2 b = (q - cheek) / glm::dvec2(0.22 * eyeDistance, 0.12 * eyeDistance);
-                    if (glm::dot(b, b) < 1.0) c = blush;
-                    // Brows: a thick stroke.
-                    for (int k = side == 0 ? 17 : 22; k < (side == 0 ? 21 : 26); ++k)
-                        if (distanceToSegment(q, at(k), at(k + 1)) < 0.05 * eyeDistance) c = brow;
-                    // Eyes: a tall almond, a big iris with a pupil and a highlight, an ink line on the upper lid.
-                    const glm::dvec2 d = (q - eyes[side]) / eyeHalf;
-                    const double lid = d.y > 0.0 ? 0.62 : 0.5;
-                    const double almond = d.x * d.x + (d.y / lid) * (d.y / lid);
-                    if (almond < 1.0) {
-                        const glm::dvec2 r = q - eyes[side];
-                        const glm::dvec2 shine = r - glm::dvec2(0.2, 0.22) * eyeHalf;
-                        c = glm::length(shine) < 0.14 * eyeHalf ? white
-                            : glm::length(r) < 0.22 * eyeHalf ? ink
-                            : (r.x / 0.5) * (r.x / 0.5) + (r.y / 0.6) * (r.y / 0.6) < eyeHalf * eyeHalf ? iris
-                                                                                              : white;
-                    } else if (almond < 1.5 && d.y > 0.05) {
-                        c = ink;
-                    }
+    cv::Mat texture = paintTexels(texels, [&](const glm::dvec3& p, const cv::Vec3f& nf) {
+        const glm::dvec2 q(p.x, p.y);
+        cv::Vec3b c = skin;
+        // Hair: a cap whose edge is high on the forehead, comes down over the temples above the ears and to the
+        // nape at the back (by the direction around the head, 0 = the face).
+        const double azimuth = std::abs(std::atan2(p.x, p.z)) * 180.0 / kPi;
+        const double front = browLine + 0.75 * eyeDistance, temple = browLine - 0.05 * eyeDistance,
+                     back = browLine - 1.2 * eyeDistance;
+        const double hairline = azimuth < 30.0 ? front
+                          : azimuth < 80.0 ? front + (temple - front) * (azimuth - 30.0) / 50.0
+                          : azimuth < 120.0 ? temple
+                          : azimuth < 160.0 ? temple + (back - temple) * (azimuth - 120.0) / 40.0
+                                            : back;
+        const bool ear = std::abs(p.x) > earX && p.y < browLine && p.y > browLine - 1.3 * eyeDistance &&
+                         p.z > -0.55 * eyeDistance && p.z < 0.3 * eyeDistance;
+        if (!ear && p.y > hairline) c = hair;
+        if (p.z > faceDepth && nf[2] > 0.2f) {
+            for (std::size_t side = 0; side < 2; ++side) {
+                // Blush under each eye.
+                const glm::dvec2 cheek = eyes[side] + glm::dvec2(side == 0 ? -0.05 : 0.05, -0.55) * eyeDistance;
+                const glm::dvec2 b = (q - cheek) / glm::dvec2(0.22 * eyeDistance, 0.12 * eyeDistance);
+                if (glm::dot(b, b) < 1.0) c = blush;
+                // Brows: a thick stroke.
+                for (int k = side == 0 ? 17 : 22; k < (side == 0 ? 21 : 26); ++k)
+                    if (distanceToSegment(q, at(k), at(k + 1)) < 0.05 * eyeDistance) c = brow;
+                // Eyes: a tall almond, a big iris with a pupil and a highlight, an ink line on the upper lid.
+                const glm::dvec2 d = (q - eyes[side]) / eyeHalf;
+                const double lid = d.y > 0.0 ? 0.62 : 0.5;
+                const double almond = d.x * d.x + (d.y / lid) * (d.y / lid);
+                if (almond < 1.0) {
+                    const glm::dvec2 r = q - eyes[side];
+                    const glm::dvec2 shine = r - glm::dvec2(0.2, 0.22) * eyeHalf;
+                    c = glm::length(shine) < 0.14 * eyeHalf ? white
+                        : glm::length(r) < 0.22 * eyeHalf ? ink
+                        : (r.x / 0.5) * (r.x / 0.5) + (r.y / 0.6) * (r.y / 0.6) < eyeHalf * eyeHalf ? iris
+                                                                                          : white;
+                } else if (almond < 1.5 && d.y > 0.05) {
+                    c = ink;
                 }
-                // Mouth: small lips and a dark line between them.
-                const glm::dvec2 mm = (q - mouth) / mouthHalf;
-                const double lipShape = mm.x * mm.x + (mm.y / 0.32) * (mm.y / 0.32);
-                if (lipShape < 0.7) c = std::abs(mm.y) < 0.05 ? mouthLine : lips;
             }
-            texture.at<cv::Vec3b>(y, x) = c;
+            // Mouth: small lips and a dark line between them.
+            const glm::dvec2 mm = (q - mouth) / mouthHalf;
+            const double lipShape = mm.x * mm.x + (mm.y / 0.32) * (mm.y / 0.32);
+            if (lipShape < 0.7) c = std::abs(mm.y) < 0.05 ? mouthLine : lips;
         }
-    }
+        return c;
+    });
     padTextureBorders(texture, texels.covered, 6);
     return texture;
 }
