@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <ctime>
+#include <tuple>
 
 namespace avatarbooth {
 namespace fs = std::filesystem;
@@ -96,10 +97,6 @@ std::unique_ptr<FitPipeline> FitPipeline::forAnotherThread() const {
 
 FitOutcome FitPipeline::fit(const FitPhotoFiles& files, const FitControl& control) const {
     const FitPhotoNames names = FitPhotoNames::of(files);
-    if (control.cancel.cancelled()) throw FitCancelled();
-    if (control.listener) control.listener(FitStep::ReadPhotos);
-    const auto t0 = Clock::now();
-    const double cpu0 = processCpuSeconds();
     const auto read = [](const fs::path& file, FitPhoto photo) {
         try {
             return readPhoto(file);
@@ -107,17 +104,21 @@ FitOutcome FitPipeline::fit(const FitPhotoFiles& files, const FitControl& contro
             throw FitError(e, photo, file.string());
         }
     };
-    const cv::Mat front = read(files.front, FitPhoto::Front);
-    const cv::Mat side = read(files.side, FitPhoto::Side);
-    const cv::Mat background = files.background.empty() ? cv::Mat() : read(files.background, FitPhoto::Both);
-    if (!background.empty() && background.size() != front.size())
-        throw FitError(ErrorKind::BadInput, FitPhoto::Both, FitFault::Other, names.background,
-                       "the background plate is " + std::to_string(background.cols) + "x" + std::to_string(background.rows) +
-                           " but the front photo is " + std::to_string(front.cols) + "x" + std::to_string(front.rows));
-    const double readSeconds = secondsSince(t0), readCpuSeconds = processCpuSeconds() - cpu0;
+    struct {
+        std::vector<std::pair<std::string, double>> stageSeconds, stageCpuSeconds;
+    } reading;
+    const auto [front, side, background] = runStep(reading, control, FitStep::ReadPhotos, names, [&] {
+        const cv::Mat f = read(files.front, FitPhoto::Front), s = read(files.side, FitPhoto::Side);
+        const cv::Mat b = files.background.empty() ? cv::Mat() : read(files.background, FitPhoto::Both);
+        if (!b.empty() && b.size() != f.size())
+            throw FitError(ErrorKind::BadInput, FitPhoto::Both, FitFault::Other, names.background,
+                           "the background plate is " + std::to_string(b.cols) + "x" + std::to_string(b.rows) +
+                               " but the front photo is " + std::to_string(f.cols) + "x" + std::to_string(f.rows));
+        return std::tuple{f, s, b};
+    });
     FitOutcome out = fit(front, side, background, names, control);
-    out.stageSeconds.insert(out.stageSeconds.begin(), {toString(FitStep::ReadPhotos), readSeconds});
-    out.stageCpuSeconds.insert(out.stageCpuSeconds.begin(), {toString(FitStep::ReadPhotos), readCpuSeconds});
+    out.stageSeconds.insert(out.stageSeconds.begin(), reading.stageSeconds.front());
+    out.stageCpuSeconds.insert(out.stageCpuSeconds.begin(), reading.stageCpuSeconds.front());
     return out;
 }
 

@@ -30,7 +30,6 @@
 
 #include <deque>
 #include <random>
-#include <thread>
 
 #include <malloc.h>
 

@@ -29,8 +29,6 @@ public:
         queue_.pop_front();
         return m;
     }
-    // The oldest message, without waiting.
-    std::optional<Message> take() { return waitUntil(std::chrono::steady_clock::time_point::min()); }
 
 private:
     std::mutex mutex_;

@@ -39,7 +39,6 @@ public:
     AvatarStyle kind() const override { return AvatarStyle::Toon; }
     // The drawing (a second or more) and then its strip are the work handed out.
     StyleWork visitor(std::uint64_t visitor, const FitOutcome& fit) override;
-    StyleWork visitor(std::uint64_t visitor, StyleInputs inputs);
     bool pending() const override { return drawing_; }
     const cv::Mat& frame(const AnimationFrame& pose, bool reveal, int size) override;
     std::uint64_t version() const override { return version_; }
@@ -49,6 +48,8 @@ public:
     void addFigures(StyleFigures& figures) const override;
 
 private:
+    StyleWork visitor(std::uint64_t visitor, StyleInputs inputs);
+
     RevealSettings settings_;
     std::uint64_t visitor_ = 0;
     bool drawing_ = false;       // the model is being made (its place shows "drawing you")
