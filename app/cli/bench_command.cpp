@@ -2,6 +2,8 @@
 // model loading reported apart. Prints figures; never fails on speed.
 #include "cli/commands.h"
 
+#include "fit/head/base_head.h"
+
 #include "common/image_io.h"
 #include "common/recent_timings.h"
 #include "fit/fit_pipeline.h"
@@ -44,7 +46,8 @@ void registerBenchCommand(CLI::App& app) {
     cmd->add_option("--background", o->inputs.background, "Empty-booth photo");
     cmd->add_option("-n,--runs", o->runs, "Runs (the first is a warm-up and not counted)")->capture_default_str()->check(CLI::Range(2, 1000));
     cmd->callback([o] {
-        const FitPipeline pipeline{FitSettings{}};
+        const auto base = productBaseHead();
+        const FitPipeline pipeline{FitSettings{}, *base};
         const cv::Mat front = readPhoto(o->inputs.front), side = readPhoto(o->inputs.side);
         const cv::Mat background = o->inputs.background.empty() ? cv::Mat() : readPhoto(o->inputs.background);
         std::map<std::string, RecentTimings> times, cpuTimes;  // keeps 2000: every run (at most 1000)

@@ -66,7 +66,8 @@ void registerFitCommand(CLI::App& app) {
             throw BoothError(ErrorKind::BadConfig, "--base-mesh/--base-features", "give both or neither");
         std::unique_ptr<BaseHead> custom;
         if (!o->baseMesh.empty()) custom = std::make_unique<BaseHead>(loadBaseHead(o->baseMesh, o->baseFeatures));
-        const BaseHead& base = custom ? *custom : builtinBaseHead();
+        const auto product = custom ? nullptr : productBaseHead();
+        const BaseHead& base = custom ? *custom : *product;
         const FitPipeline pipeline(settings, base);
         const FitOutcome outcome = pipeline.fit(o->inputs);
         std::optional<CharacterOutputs> character;

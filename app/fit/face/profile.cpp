@@ -261,6 +261,14 @@ NoseChoice noseCandidate(const Chain& f, double yTop, const WidthProfile& widths
     return best;
 }
 
+ProfileFit fail(std::string why) {
+    ProfileFit f;
+    f.failure = std::move(why);
+    return f;
+}
+
+}  // namespace
+
 // Porion (ear hole) estimate. A silhouette does not show the ear, so it is placed by proportions, in a frame
 // aligned with the face: the soft-tissue facial line nasion-chin stands about perpendicular to the Frankfurt plane
 // (Holdaway's soft-tissue facial angle, about 91 degrees), so turning the profile until that line is vertical
@@ -284,14 +292,6 @@ cv::Point2d estimateEarHole(const cv::Point2d& nasion, const cv::Point2d& chin, 
     const cv::Point2d q(-kEarBehindNasion * V, kEarBelowNasion * V);
     return nasion + cv::Point2d(q.x * c + q.y * s, -q.x * s + q.y * c);
 }
-
-ProfileFit fail(std::string why) {
-    ProfileFit f;
-    f.failure = std::move(why);
-    return f;
-}
-
-}  // namespace
 
 ProfileFit fitProfile(const std::vector<cv::Point2d>& outlineIn, bool noseRight) {
     if (!noseRight) {

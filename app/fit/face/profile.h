@@ -44,6 +44,11 @@ struct ProfileFit {
 // every constant.
 ProfileFit fitProfile(const std::vector<cv::Point2d>& outline, bool noseRight = true);
 
+// The ear hole (porion) placed by proportions from the nasion and chin of a profile facing image-right (pixels, y
+// down) and V, the nose tip's height below the top of the head; the base head places its own ear hole by the same
+// rule, so that the side photo's centre and the base head's agree.
+cv::Point2d estimateEarHole(const cv::Point2d& nasion, const cv::Point2d& chin, double V);
+
 // As fitProfile, returning the landmarks; throws BoothError(NoFace) with the reason when no profile is found.
 // Warnings (estimated points) are appended to *warnings when given.
 std::vector<ProfilePoint> findProfileLandmarks(const std::vector<cv::Point2d>& outline, bool noseRight = true,

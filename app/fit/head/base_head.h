@@ -3,6 +3,9 @@
 #pragma once
 
 #include "fit/head/mesh.h"
+#include "fit/head/modifier_basis.h"
+
+#include <opencv2/core.hpp>
 
 #include <filesystem>
 #include <map>
@@ -31,6 +34,13 @@ struct BaseHead {
     std::vector<ContourVertex> sideContour;
     // The point between the ear holes (the side photo's centre); the built-in head has it at the origin.
     glm::dvec3 earHoleCentre{0.0};
+    // Parts that move as one rigid piece (the eyeballs): the warp gives each its vertices' mean displacement, so a
+    // sphere of small triangles is never bent.
+    std::vector<std::vector<std::uint32_t>> rigidParts;
+    // The shapes the fit's first step blends (the MakeHuman head's; none for a head without them).
+    std::shared_ptr<const ModifierBasis> modifiers;
+    // A skin texture on the head's UVs (BGR) for what no photo sees; empty: the photos' colours are spread there.
+    cv::Mat skin;
 
     // Midpoint of the two eye centres (mean of ibug 36-41 and of 42-47): the front photo's centre.
     glm::dvec3 eyeMidpoint() const;
@@ -42,12 +52,22 @@ const BaseHead& builtinBaseHead();
 // landmark model at exit reads it).
 std::shared_ptr<const BaseHead> sharedBuiltinBaseHead();
 
+// The product's base head: MakeHuman's (makehuman_import.h), made at build time into share/avatarbooth/base_head/
+// and looked for in $AVATARBOOTH_ASSET_DIR/base_head, <exe>/../share/avatarbooth/base_head, the build tree and
+// /usr/share/avatarbooth/base_head. Loaded once; throws BoothError(BadConfig) saying where it looked when none is
+// there. The built-in head above stays as the small test fixture.
+std::shared_ptr<const BaseHead> productBaseHead();
+// The folder it is loaded from, or empty.
+std::filesystem::path findMakeHumanBaseHead();
+
 // Loads an operator's own base head: a glTF binary mesh (positions, UVs, one primitive) and a feature file
 // (JSON, the format written by saveBaseHead). Errors name the file and the field.
 BaseHead loadBaseHead(const std::filesystem::path& meshGlb, const std::filesystem::path& featureJson);
 
-// Writes the feature file of a base head (its mesh is written with the glb exporter).
-void saveFeatureFile(const BaseHead& head, const std::filesystem::path& featureJson);
+// Writes the feature file of a base head (its mesh is written with the glb exporter). The modifier basis and skin
+// files, when named, are recorded relative to the feature file, and loadBaseHead reads them from there.
+void saveFeatureFile(const BaseHead& head, const std::filesystem::path& featureJson,
+                     const std::string& modifiersFile = "", const std::string& skinFile = "");
 
 // Finds the contour vertices of a mesh seen orthographically along `viewAxis` (0 = from +z: front, 1 = from -x:
 // the subject's right side), by rays from `centre` (projected) at the given angles.

@@ -4,7 +4,9 @@
 #include "common/error.h"
 #include "common/landmark_names.h"
 #include "fit/fit_error.h"
+#include "fit/head/folds.h"
 #include "fit/head/head_views.h"
+#include "fit/head/modifier_fit.h"
 
 #include <opencv2/core.hpp>
 
@@ -99,16 +101,34 @@ struct ViewTargets {
     std::vector<std::pair<std::string, glm::dvec2>> targets;
     std::set<std::uint32_t> used;
 
-    void add(const Mesh& mesh, const std::string& name, std::uint32_t v, const glm::dvec2& target) {
+    // A point measured on a smooth stretch of outline says only how far out the outline is there, not where along
+    // it the point lies: with `normal` (the vertex normal) only the target's component along the outline's normal
+    // in this view is kept, so that the surface is pushed out or in, never dragged along itself (which folds it).
+    void add(const Mesh& mesh, const std::string& name, std::uint32_t v, glm::dvec2 target,
+             const std::vector<glm::dvec3>* normals = nullptr) {
         if (!used.insert(v).second) return;
         const glm::dvec3 c = mesh.positions[v];
         const glm::dvec2 now = projectToView(c, view);
+        if (normals) {
+            const glm::dvec2 n = projectToView((*normals)[v], view);
+            if (glm::length(n) > 1e-6) {
+                const glm::dvec2 u = glm::normalize(n);
+                target = now + u * glm::dot(u, target - now);
+            }
+        }
         centres.push_back(c);
         displacements.push_back({target.x - now.x, target.y - now.y});
         vertices.push_back(v);
         targets.emplace_back(name, target);
     }
 };
+
+// The profile landmarks that are extremes or dips of a smooth stretch of outline (the most forward point of the
+// brow, the chin, the lips, the deepest point of the nasion or under the chin, the highest and the most backward
+// point, half-way up the forehead): their depth is measured, their height along the curve is a convention that one
+// pixel of noise moves by millimetres, and pulling a vertex along the surface folds it. The nose tip and the
+// subnasale are corners, measured both ways; the front photo gives the heights of the rest.
+bool onSmoothOutline(const std::string& name) { return name != "nose_tip" && name != "subnasale"; }
 
 }  // namespace
 
@@ -124,12 +144,16 @@ cv::Point2d PhotoFrame::toPixel(const glm::dvec2& head) const {
 
 HeadFitOptions defaultHeadFitOptions() {
     HeadFitOptions o;
-    // The chin (8), brows, nose, eyes and the outer lips. Not the other jaw points: dlib places them on the visible
-    // cheek outline, which is no fixed point of the head (it moves with the face's fullness and the slightest
+    // The chin (8), brows, nose, eye corners and the outer lips. Not the other jaw points: dlib places them on the
+    // visible cheek outline, which is no fixed point of the head (it moves with the face's fullness and the slightest
     // turn): with them the synthetic visitor's detected-landmark fit is further from its true head (tests/integration).
-    // (They still give the head's width for the scaling step.) Not the inner lips, which follow the mouth's opening.
+    // (They still give the head's width for the scaling step.) Not the inner lips, which follow the mouth's opening,
+    // nor the eyelids between the corners, which follow the eyes' opening: pulled to a photo's, the thin skin of the
+    // lids folds over the rigid eyeball.
     o.frontLandmarks.push_back(8);
-    for (int k = 17; k < 60; ++k) o.frontLandmarks.push_back(k);
+    for (int k = 17; k < 36; ++k) o.frontLandmarks.push_back(k);
+    for (const int k : {36, 39, 42, 45}) o.frontLandmarks.push_back(k);
+    for (int k = 48; k < 60; ++k) o.frontLandmarks.push_back(k);
     return o;
 }
 
@@ -191,80 +215,126 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     }
     tieError = std::sqrt(tieError / 5.0);
 
-    // --- Step 2: per-axis scale of the base head from the measured extents, about the ear-hole centre.
-    const auto pos = [&](const std::string& name) { return b.positions[base.sideFeatures.at(name)]; };
-    const glm::dvec3 chinB = b.positions[base.frontFeatures.at(landmarkName(8))];
-    const double heightPhoto = frontRel(topPx).y - frontRel(fp.at(landmarkName(8))).y;
-    const double heightBase = pos("top_of_head").y - chinB.y;
-    const double widthPhoto = std::abs(frontRel(fp.at(landmarkName(16))).x - frontRel(fp.at(landmarkName(0))).x);
-    const double widthBase = std::abs(b.positions[base.frontFeatures.at(landmarkName(16))].x - b.positions[base.frontFeatures.at(landmarkName(0))].x);
-    const double depthPhoto = (side("glabella").x - side("back_of_head").x) * sideMmPerPx;
-    const double depthBase = pos("glabella").z - pos("back_of_head").z;
-    fit.axisScale = glm::dvec3(widthPhoto / widthBase, heightPhoto / heightBase, depthPhoto / depthBase);
-    for (int c = 0; c < 3; ++c)
-        if (!(fit.axisScale[c] > 0.6 && fit.axisScale[c] < 1.6))
-            throw BoothError(ErrorKind::Mismatch, "",
-                             std::string("the measured head ") + (c == 0 ? "width" : c == 1 ? "height" : "depth") +
-                                 " is " + std::to_string(fit.axisScale[c]) + " times the base head's: not a plausible head");
-    if (tieError > 0.06 * heightPhoto)
-        throw BoothError(ErrorKind::Mismatch, "",
-                         "the heights of the nose, lips and top of head disagree between the photos by " +
-                             std::to_string(static_cast<int>(tieError)) + " mm: they do not show the same head");
-    if (tieError > 0.025 * heightPhoto)
-        fit.warnings.push_back("shared heights between the photos disagree by " + std::to_string(tieError) + " mm (RMS)");
-    fit.scaledBase = b;
-    for (auto& p : fit.scaledBase.positions) p = base.earHoleCentre + (p - base.earHoleCentre) * fit.axisScale;
-    const Mesh& s = fit.scaledBase;
-    const glm::dvec3 eyeMidScaled = meanVertex(s, base, 36, 47);
-    const glm::dvec3 earScaled = base.earHoleCentre;  // the scaling's fixed point
-
-    fit.front = PhotoFrame{eyeMidPx, frontMmPerPx, {eyeMidScaled.x, eyeMidScaled.y}, false, photos.frontMask.cols};
-    const cv::Point2d earPx = side("ear_hole");
-    fit.side = PhotoFrame{cv::Point2d(earPx.x, earPx.y), sideMmPerPx, {earScaled.z, eyeMidScaled.y + a * earPx.y + bOffset},
-                          false, sideWidth};
-    // sideCanonical works on the mirrored image; fit.side takes raw photo pixels (it mirrors u first).
-    PhotoFrame sideCanonical = fit.side;
-    fit.side.mirrored = mirror;
-
-    // --- Steps 3-4: targets for the feature and contour vertices.
+    // --- Steps 2-4, and with a modifier basis the first fitting step between them: scale the head to the measured
+    // extents, measure the feature and contour targets, fit the modifier weights to them, and again with the new
+    // shape (the extents and the rays change with it); the last round's targets go to the warp.
+    Mesh shaped = base.mesh;
+    // Where the photos' frames sit against the head, as the modifier fit corrects them: the side frame's depth rests
+    // on the ear hole's estimate (about 5 % of the head's height off, more under a bun of hair), which the profile's
+    // face points correct.
+    glm::dvec3 frameShift(0.0), frameAnchor(0.0);
     ViewTargets frontT(View::Front), sideT(View::Side);
-    const auto addFront = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) { frontT.add(s, name, v, target); };
-    const auto addSide = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) { sideT.add(s, name, v, target); };
-    for (const int k : options.frontLandmarks) {
-        const std::string name = landmarkName(k);
-        addFront(name, base.frontFeatures.at(name), fit.front.toHead(fp.at(name)));
-    }
-    // Below the eye line the silhouette can run on into hair, a collar or the shoulders. dlib's jaw line (points
-    // 0..16, a little inside the true outline: it follows the cheek) says where the face's own outline must be; a
-    // crossing much farther out than it is not the face, and that ray measures nothing.
-    std::vector<cv::Point2d> jawLine;
-    for (int k = 0; k <= 16; ++k) jawLine.push_back(fp.at(landmarkName(k)));
-    constexpr double kOutlineBeyondJaw = 1.4;
-    for (const auto& cv : base.frontContour) {
-        const glm::dvec3 p = s.positions[cv.vertex];
-        const cv::Point2d dir(p.x - eyeMidScaled.x, -(p.y - eyeMidScaled.y));
-        const cv::Point2d hit = outlineCrossing(photos.frontMask, eyeMidPx, dir, "front");
-        if (cv.angleDeg > 180.0) {
-            const auto onJaw = polylineCrossing(jawLine, eyeMidPx, dir);
-            if (!onJaw || cv::norm(hit - eyeMidPx) > kOutlineBeyondJaw * cv::norm(*onJaw - eyeMidPx)) continue;
+    for (int round = 0;; ++round) {
+        frontT = ViewTargets(View::Front);
+        sideT = ViewTargets(View::Side);
+        fit.frontRays.clear();
+        fit.sideRays.clear();
+        const auto pos = [&](const std::string& name) { return shaped.positions[base.sideFeatures.at(name)]; };
+        const glm::dvec3 chinB = shaped.positions[base.frontFeatures.at(landmarkName(8))];
+        const double heightPhoto = frontRel(topPx).y - frontRel(fp.at(landmarkName(8))).y;
+        const double heightBase = pos("top_of_head").y - chinB.y;
+        const double widthPhoto = std::abs(frontRel(fp.at(landmarkName(16))).x - frontRel(fp.at(landmarkName(0))).x);
+        const double widthBase = std::abs(shaped.positions[base.frontFeatures.at(landmarkName(16))].x - shaped.positions[base.frontFeatures.at(landmarkName(0))].x);
+        const double depthPhoto = (side("glabella").x - side("back_of_head").x) * sideMmPerPx;
+        const double depthBase = pos("glabella").z - pos("back_of_head").z;
+        // Measured once, on the base head: in later rounds the modifiers change the extents, and scaling them back
+        // to the measured ones would undo what the modifiers found.
+        if (round == 0) fit.axisScale = glm::dvec3(widthPhoto / widthBase, heightPhoto / heightBase, depthPhoto / depthBase);
+        for (int c = 0; c < 3; ++c)
+            if (!(fit.axisScale[c] > 0.6 && fit.axisScale[c] < 1.6))
+                throw BoothError(ErrorKind::Mismatch, "",
+                                 std::string("the measured head ") + (c == 0 ? "width" : c == 1 ? "height" : "depth") +
+                                     " is " + std::to_string(fit.axisScale[c]) + " times the base head's: not a plausible head");
+        if (tieError > 0.06 * heightPhoto)
+            throw BoothError(ErrorKind::Mismatch, "",
+                             "the heights of the nose, lips and top of head disagree between the photos by " +
+                                 std::to_string(static_cast<int>(tieError)) + " mm: they do not show the same head");
+        if (round == 0 && tieError > 0.025 * heightPhoto)
+            fit.warnings.push_back("shared heights between the photos disagree by " + std::to_string(tieError) + " mm (RMS)");
+        fit.scaledBase = shaped;
+        for (auto& p : fit.scaledBase.positions) p = base.earHoleCentre + (p - base.earHoleCentre) * fit.axisScale;
+        const Mesh& scaled = fit.scaledBase;
+        // The frames are anchored once, at the scaled base head's eye midpoint; the modifier fit's translation moves
+        // them from there (a later round's eye midpoint has moved with the modifiers, which the fit already counted).
+        if (round == 0) frameAnchor = meanVertex(scaled, base, 36, 47);
+        const glm::dvec3 eyeMidScaled = frameAnchor;
+        const glm::dvec3 earScaled = base.earHoleCentre;  // the scaling's fixed point
+
+        fit.front = PhotoFrame{eyeMidPx, frontMmPerPx, {eyeMidScaled.x - frameShift.x, eyeMidScaled.y - frameShift.y}, false,
+                               photos.frontMask.cols};
+        const cv::Point2d earPx = side("ear_hole");
+        fit.side = PhotoFrame{cv::Point2d(earPx.x, earPx.y), sideMmPerPx, {earScaled.z - frameShift.z, eyeMidScaled.y - frameShift.y + a * earPx.y + bOffset},
+                              false, sideWidth};
+        // sideCanonical works on the mirrored image; fit.side takes raw photo pixels (it mirrors u first).
+        PhotoFrame sideCanonical = fit.side;
+        fit.side.mirrored = mirror;
+
+        // --- Steps 3-4: targets for the feature and contour vertices.
+        const std::vector<glm::dvec3> scaledNormals = scaled.vertexNormals();
+        const auto addFront = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) { frontT.add(scaled, name, v, target); };
+        // Contour points: along the outline's normal only (see ViewTargets::add).
+        const auto addFrontContour = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) {
+            frontT.add(scaled, name, v, target, &scaledNormals);
+        };
+        const auto addSide = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) {
+            sideT.add(scaled, name, v, target, &scaledNormals);
+        };
+        for (const int k : options.frontLandmarks) {
+            const std::string name = landmarkName(k);
+            addFront(name, base.frontFeatures.at(name), fit.front.toHead(fp.at(name)));
         }
-        fit.frontRays.emplace_back(eyeMidPx, hit);
-        addFront("front_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, fit.front.toHead(hit));
+        // Below the eye line the silhouette can run on into hair, a collar or the shoulders. dlib's jaw line (points
+        // 0..16, a little inside the true outline: it follows the cheek) says where the face's own outline must be; a
+        // crossing much farther out than it is not the face, and that ray measures nothing.
+        std::vector<cv::Point2d> jawLine;
+        for (int k = 0; k <= 16; ++k) jawLine.push_back(fp.at(landmarkName(k)));
+        constexpr double kOutlineBeyondJaw = 1.25;
+        for (const auto& cv : base.frontContour) {
+            const glm::dvec3 p = scaled.positions[cv.vertex];
+            const cv::Point2d dir(p.x - fit.front.offsetMm.x, -(p.y - fit.front.offsetMm.y));
+            const cv::Point2d hit = outlineCrossing(photos.frontMask, eyeMidPx, dir, "front");
+            if (cv.angleDeg > 180.0) {
+                const auto onJaw = polylineCrossing(jawLine, eyeMidPx, dir);
+                if (!onJaw || cv::norm(hit - eyeMidPx) > kOutlineBeyondJaw * cv::norm(*onJaw - eyeMidPx)) continue;
+            }
+            fit.frontRays.emplace_back(eyeMidPx, hit);
+            addFrontContour("front_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, fit.front.toHead(hit));
+        }
+        for (const auto& [name, v] : base.sideFeatures) {
+            const auto it = photos.sidePoints.find(name);
+            if (it == photos.sidePoints.end()) continue;
+            sideT.add(scaled, name, v, sideCanonical.toHead(mirrorPoint(it->second, sideWidth, mirror)),
+                      onSmoothOutline(name) ? &scaledNormals : nullptr);
+        }
+        const cv::Point2d earCanonical = earPx;
+        for (const auto& cv : base.sideContour) {
+            const glm::dvec3 p = scaled.positions[cv.vertex];
+            const glm::dvec2 earHead = sideCanonical.toHead(earCanonical);
+            const cv::Point2d dir(p.z - earHead.x, -(p.y - earHead.y));
+            const cv::Point2d hit = outlineCrossing(sideMask, earCanonical, dir, "side");
+            fit.sideRays.emplace_back(mirrorPoint(earCanonical, sideWidth, mirror), mirrorPoint(hit, sideWidth, mirror));
+            addSide("side_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, sideCanonical.toHead(hit));
+        }
+
+        if (!base.modifiers || round == options.modifierRounds) break;
+        std::vector<ModifierTarget> targets;
+        for (const ViewTargets* view : {&frontT, &sideT})
+            for (std::size_t k = 0; k < view->vertices.size(); ++k) {
+                // The outline rays meet hair as often as skin: they shape the head less than the landmarks do.
+                const bool contour = view->targets[k].first.find("_contour_") != std::string::npos;
+                targets.push_back({view->vertices[k], view->view, view->targets[k].second,
+                                   glm::dvec2(contour ? options.contourWeight : 1.0)});
+            }
+        const ModifierFit m = fitModifiers(*base.modifiers, base.mesh.positions, fit.axisScale, base.earHoleCentre, targets,
+                                           options.modifiers);
+        shaped.positions = base.modifiers->apply(base.mesh.positions, m.weights);
+        frameShift += m.translation;
+        fit.modifierWeights.clear();
+        for (std::size_t k = 0; k < m.weights.size(); ++k)
+            if (m.weights[k] > 1e-4) fit.modifierWeights.emplace_back(base.modifiers->modifiers[k].name, m.weights[k]);
+        fit.modifierRmsMm = {m.rmsBeforeMm, m.rmsAfterMm};
     }
-    for (const auto& [name, v] : base.sideFeatures) {
-        const auto it = photos.sidePoints.find(name);
-        if (it == photos.sidePoints.end()) continue;
-        addSide(name, v, sideCanonical.toHead(mirrorPoint(it->second, sideWidth, mirror)));
-    }
-    const cv::Point2d earCanonical = earPx;
-    for (const auto& cv : base.sideContour) {
-        const glm::dvec3 p = s.positions[cv.vertex];
-        const glm::dvec2 earHead = sideCanonical.toHead(earCanonical);
-        const cv::Point2d dir(p.z - earHead.x, -(p.y - earHead.y));
-        const cv::Point2d hit = outlineCrossing(sideMask, earCanonical, dir, "side");
-        fit.sideRays.emplace_back(mirrorPoint(earCanonical, sideWidth, mirror), mirrorPoint(hit, sideWidth, mirror));
-        addSide("side_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, sideCanonical.toHead(hit));
-    }
+    const Mesh& s = fit.scaledBase;
 
     // --- Step 5: the RBF warps, (x, y) from the front and (z, y) from the side, merged.
     const RbfWarp frontWarp(frontT.centres, frontT.displacements, options.rbf);
@@ -298,6 +368,15 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     }
     const RbfWarp yWarp(yCentres, yDisp, options.rbf);
     for (auto& p : fit.mesh.positions) p.y += yWarp.evaluate(p)[0];
+    // Where features lie close together with conflicting pulls (eyelids, lips) the warp can turn the surface over;
+    // those places take their neighbours' displacement instead.
+    for (const auto& part : base.rigidParts) {
+        glm::dvec3 mean(0.0);
+        for (const auto v : part) mean += fit.mesh.positions[v] - fit.scaledBase.positions[v];
+        mean /= static_cast<double>(std::max<std::size_t>(part.size(), 1));
+        for (const auto v : part) fit.mesh.positions[v] = fit.scaledBase.positions[v] + mean;
+    }
+    fit.foldsRemoved = unfold(fit.scaledBase, fit.mesh);
 
     for (const ViewTargets* view : {&frontT, &sideT})
         for (std::size_t k = 0; k < view->vertices.size(); ++k) {

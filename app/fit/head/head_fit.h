@@ -3,6 +3,7 @@
 #pragma once
 
 #include "fit/head/base_head.h"
+#include "fit/head/modifier_fit.h"
 #include "fit/head/rbf.h"
 
 #include <opencv2/core.hpp>
@@ -28,6 +29,12 @@ struct HeadFitOptions {
     std::vector<int> frontLandmarks;
     // Accepted ratio between the two photos' scales before they are called a mismatch.
     double maxScaleRatio = 1.35;
+    // The first step, with a base head that has a modifier basis: the weights' fit, and how many times it is done
+    // again with the shape it found (0: the modifiers are not fitted).
+    ModifierFitOptions modifiers;
+    int modifierRounds = 1;
+    // Weight of an outline point against a landmark's in the modifier fit.
+    double contourWeight = 0.3;
 };
 
 HeadFitOptions defaultHeadFitOptions();
@@ -56,13 +63,18 @@ struct PhotoFrame {
 
 struct HeadFit {
     Mesh mesh;                   // the fitted head (base head topology)
-    Mesh scaledBase;             // the base head after step 2 (per-axis scaling), before the warp
+    Mesh scaledBase;             // the base head after steps 1-2 (modifiers, per-axis scaling), before the warp
     glm::dvec3 axisScale{1.0};   // sx, sy, sz of step 2
     PhotoFrame front, side;
     std::vector<FeatureResidual> residuals;
     // Contour rays for the overlays: from the view's centre to the measured outline point (pixels).
     std::vector<std::pair<cv::Point2d, cv::Point2d>> frontRays, sideRays;
     std::vector<std::string> warnings;
+    // The first step's result: the modifiers it used (name, weight in (0, 1]) and the targets' RMS error before and
+    // after it (millimetres).
+    std::vector<std::pair<std::string, double>> modifierWeights;
+    std::pair<double, double> modifierRmsMm{0.0, 0.0};
+    std::size_t foldsRemoved = 0;  // triangles the warp had turned over, before they were smoothed out
 };
 
 // Throws BoothError(Mismatch) when the photos disagree (scale ratio, shared heights), NoFace when a needed

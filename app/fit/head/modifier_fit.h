@@ -1,0 +1,49 @@
+// The fit's first step (issue 21): the modifier weights that bring the base head's feature and contour vertices
+// nearest their measured positions, as a bounded, regularised linear least-squares problem (the shape fitting of
+// eos, Huber et al. 2016, with MakeHuman's targets for the morphable model's basis).
+//
+// Model: vertex v at weights w is c + S (b_v + sum_k w_k d_kv - c), seen in the front view as (x, y) and in the side
+// view as (z, y), plus a translation (t_x, t_y, t_z) of the photos' frames against the head (the frames are placed
+// by the eye midpoint and the ear hole of the head before its shape is known). Minimised:
+//   sum over targets |projected vertex - target|^2 + lambda sum_k w_k^2,  0 <= w_k <= 1,
+// so w = 0 (the average head) is what the photos must argue the head away from.
+#pragma once
+
+#include "fit/head/head_views.h"
+#include "fit/head/modifier_basis.h"
+
+#include <string>
+#include <vector>
+
+namespace avatarbooth {
+
+struct ModifierTarget {
+    std::uint32_t vertex = 0;
+    View view = View::Front;
+    glm::dvec2 target{0.0};  // millimetres, in the view's plane
+    glm::dvec2 weight{1.0};  // of each coordinate's squared error (0: the photo does not measure it)
+};
+
+struct ModifierFitOptions {
+    // lambda, in square millimetres per unit weight squared: a modifier at full weight must remove this much squared
+    // error to be worth it.
+    double regularisation = 30.0;
+    int sweeps = 400;  // projected Gauss-Seidel sweeps over the normal equations
+    // Modifier groups held at 0: the ears, which no photo measurement sees (the outline rays pass above and below
+    // them), would otherwise be bent to fit rays that meet hair.
+    std::vector<std::string> fixedGroups = {"ears"};
+};
+
+struct ModifierFit {
+    std::vector<double> weights;       // one per modifier, in [0, 1]
+    glm::dvec3 translation{0.0};       // of the frames, millimetres
+    double rmsBeforeMm = 0.0, rmsAfterMm = 0.0;  // over the targets, at w = 0 and at the solution
+};
+
+// basePositions: the base head's (unscaled) positions; scale and centre: the per-axis scaling about the ear-hole
+// centre that the measured extents gave (S and c above).
+ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec3>& basePositions, const glm::dvec3& scale,
+                         const glm::dvec3& centre, const std::vector<ModifierTarget>& targets,
+                         const ModifierFitOptions& options = {});
+
+}  // namespace avatarbooth

@@ -1,0 +1,105 @@
+// The fit's first step: bounded, regularised least squares for the modifier weights (fit/head/modifier_fit.h).
+#include "fit/head/modifier_fit.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace avatarbooth {
+namespace {
+
+// A cloud of vertices and four modifiers, each moving a different set of them in a different direction.
+struct Problem {
+    std::vector<glm::dvec3> base;
+    ModifierBasis basis;
+};
+
+Problem makeProblem() {
+    Problem p;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-80.0, 80.0);
+    for (int i = 0; i < 40; ++i) p.base.emplace_back(u(rng), u(rng), u(rng));
+    p.basis.vertexCount = p.base.size();
+    const glm::vec3 dirs[] = {{6, 0, 0}, {0, 5, 0}, {0, 0, 7}, {3, -4, 2}};
+    for (int k = 0; k < 4; ++k) {
+        Modifier m;
+        m.name = "m" + std::to_string(k);
+        for (std::uint32_t v = static_cast<std::uint32_t>(k); v < p.base.size(); v += 2) {
+            m.vertices.push_back(v);
+            m.offsets.push_back(dirs[k] * (1.0f + 0.02f * static_cast<float>(v)));
+        }
+        p.basis.modifiers.push_back(m);
+    }
+    return p;
+}
+
+// The targets a head shaped by `weights`, scaled by `scale` about `centre` and shifted by `shift`, shows in both views.
+std::vector<ModifierTarget> targetsFor(const Problem& p, const std::vector<double>& weights, const glm::dvec3& scale,
+                                       const glm::dvec3& centre, const glm::dvec3& shift) {
+    const auto shaped = p.basis.apply(p.base, weights);
+    std::vector<ModifierTarget> t;
+    for (std::uint32_t v = 0; v < shaped.size(); ++v) {
+        const glm::dvec3 q = centre + scale * (shaped[v] - centre) + shift;
+        t.push_back({v, View::Front, projectToView(q, View::Front)});
+        t.push_back({v, View::Side, projectToView(q, View::Side)});
+    }
+    return t;
+}
+
+TEST(ModifierFit, RecoversKnownWeightsScaleAndShift) {
+    const Problem p = makeProblem();
+    const std::vector<double> truth = {0.3, 0.0, 0.85, 0.5};
+    const glm::dvec3 scale(1.1, 0.95, 1.05), centre(0.0, 2.0, -3.0), shift(4.0, -2.5, 1.5);
+    ModifierFitOptions o;
+    o.regularisation = 1e-9;
+    o.sweeps = 5000;
+    const ModifierFit f = fitModifiers(p.basis, p.base, scale, centre, targetsFor(p, truth, scale, centre, shift), o);
+    ASSERT_EQ(f.weights.size(), truth.size());
+    for (std::size_t k = 0; k < truth.size(); ++k) EXPECT_NEAR(f.weights[k], truth[k], 1e-5) << k;
+    EXPECT_NEAR(f.translation.x, shift.x, 1e-4);
+    EXPECT_NEAR(f.translation.y, shift.y, 1e-4);
+    EXPECT_NEAR(f.translation.z, shift.z, 1e-4);
+    EXPECT_GT(f.rmsBeforeMm, 1.0);
+    EXPECT_LT(f.rmsAfterMm, 1e-4);
+}
+
+TEST(ModifierFit, WeightsStayWithinTheirRange) {
+    const Problem p = makeProblem();
+    // Asked for 2.5 of the first modifier and "-1" of the second: the bounds hold them at 1 and 0.
+    const std::vector<double> beyond = {2.5, 0.0, 0.4, 0.0};
+    auto targets = targetsFor(p, beyond, glm::dvec3(1.0), glm::dvec3(0.0), glm::dvec3(0.0));
+    const auto moved = p.basis.apply(p.base, {0.0, 1.0, 0.0, 0.0});
+    for (std::size_t i = 0; i < targets.size(); ++i)  // the second modifier's vertices pulled the opposite way
+        targets[i].target -= projectToView(moved[targets[i].vertex] - p.base[targets[i].vertex], targets[i].view);
+    ModifierFitOptions o;
+    o.regularisation = 1e-9;
+    o.sweeps = 5000;
+    const ModifierFit f = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
+    EXPECT_DOUBLE_EQ(f.weights[0], 1.0);
+    EXPECT_DOUBLE_EQ(f.weights[1], 0.0);
+    for (const double w : f.weights) {
+        EXPECT_GE(w, 0.0);
+        EXPECT_LE(w, 1.0);
+    }
+}
+
+TEST(ModifierFit, RegularisationPullsTowardsTheAverage) {
+    const Problem p = makeProblem();
+    const std::vector<double> truth = {0.6, 0.6, 0.6, 0.6};
+    const auto targets = targetsFor(p, truth, glm::dvec3(1.0), glm::dvec3(0.0), glm::dvec3(0.0));
+    double previous = 1e9;
+    for (const double lambda : {1e-6, 100.0, 10000.0, 1e7}) {
+        ModifierFitOptions o;
+        o.regularisation = lambda;
+        o.sweeps = 5000;
+        const ModifierFit f = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
+        double sum = 0.0;
+        for (const double w : f.weights) sum += w;
+        EXPECT_LT(sum, previous + 1e-9) << lambda;
+        previous = sum;
+    }
+    EXPECT_LT(previous, 0.05);  // at a huge lambda the head stays the average one
+}
+
+}  // namespace
+}  // namespace avatarbooth
