@@ -65,29 +65,41 @@ void clearInjectedWriteFailure() { gWritesBeforeFailure = -1; }
 int injectedWriteFailures() { return gInjectedFailures.load(); }
 
 void writeFileAtomically(const fs::path& path, std::string_view bytes) {
+    writeFileAtomically(path, std::span<const std::string_view>(&bytes, 1));
+}
+
+void writeFileAtomically(const fs::path& path, std::span<const std::string_view> pieces) {
     const fs::path tmp = path.string() + ".tmp-" + randomSuffix();
     // 0600: outputs hold photos of visitors, personal data readable only by the booth's user.
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
     if (fd < 0) failOutput(path, "cannot create", errno);
     const bool injected = injectedFailureDue();
-    std::size_t done = 0;
-    while (done < bytes.size() || injected) {
-        // An injected failure strikes after half the bytes, as a disk filling up in the middle of a file does.
-        const std::size_t chunk = injected ? (bytes.size() - done) / 2 : bytes.size() - done;
-        ssize_t n = ::write(fd, bytes.data() + done, chunk);
-        if (injected && n >= 0) {
-            ++gInjectedFailures;
-            n = -1;
-            errno = gInjectedError.load();
+    const auto fail = [&](int err) {
+        ::close(fd);
+        ::unlink(tmp.c_str());
+        failOutput(path, "cannot write", err);
+    };
+    for (const std::string_view bytes : pieces) {
+        std::size_t done = 0;
+        while (done < bytes.size() || injected) {
+            // An injected failure strikes after half the bytes, as a disk filling up in the middle of a file does.
+            const std::size_t chunk = injected ? (bytes.size() - done) / 2 : bytes.size() - done;
+            ssize_t n = ::write(fd, bytes.data() + done, chunk);
+            if (injected && n >= 0) {
+                ++gInjectedFailures;
+                n = -1;
+                errno = gInjectedError.load();
+            }
+            if (n < 0) {
+                if (errno == EINTR) continue;
+                fail(errno);
+            }
+            done += static_cast<std::size_t>(n);
         }
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            const int err = errno;
-            ::close(fd);
-            ::unlink(tmp.c_str());
-            failOutput(path, "cannot write", err);
-        }
-        done += static_cast<std::size_t>(n);
+    }
+    if (injected) {  // a file of no bytes at all fails too
+        ++gInjectedFailures;
+        fail(gInjectedError.load());
     }
     if (::fsync(fd) != 0 || ::close(fd) != 0) {
         const int err = errno;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -10,6 +11,8 @@ namespace avatarbooth {
 
 // Writes bytes to path through path.tmp-XXXX + fsync + rename. Throws BoothError(Output) naming the file.
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
+// The same for a file made of several pieces, written one after the other (large arrays need no joined copy).
+void writeFileAtomically(const std::filesystem::path& path, std::span<const std::string_view> pieces);
 
 // Fault injection for the reliability tests (tests/reliability/): after `afterWrites` more successful
 // writeFileAtomically() calls, every later call fails as write(2) failing with `error` would (ENOSPC: the disk is

@@ -89,6 +89,8 @@ TEST(ApplianceSystemd, ServiceUnitIsNotifyWithWatchdogAndRestart) {
     EXPECT_NE(unit.find("\nRestart=always\n"), std::string::npos);
     EXPECT_NE(unit.find("\nUser=avatarbooth\n"), std::string::npos);
     EXPECT_NE(unit.find("\nSupplementaryGroups=video gpio render input\n"), std::string::npos);
+    // $CACHE_DIRECTORY, where the converted landmark model is kept (fit/face/model_cache.h).
+    EXPECT_NE(unit.find("\nCacheDirectory=avatarbooth\n"), std::string::npos);
     // The kiosk pings at half of WatchdogSec while its loop runs: long enough for a slow frame, and not off.
     std::smatch m;
     ASSERT_TRUE(std::regex_search(unit, m, std::regex("\nWatchdogSec=([0-9]+)s\n"))) << "WatchdogSec=Ns missing";
@@ -132,6 +134,8 @@ TEST(ApplianceSystemd, TmpfilesAndSysusersMakeTheUserAndItsFolder) {
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_EQ(mode(root / "var/lib/avatarbooth"), "0750");
     EXPECT_EQ(mode(root / "var/lib/avatarbooth/sessions"), "0750");
+    // The cache of the converted landmark model, the booth user's alone (fit/face/model_cache.h looks there).
+    EXPECT_EQ(mode(root / "var/cache/avatarbooth"), "0700");
     // The sessions folder of tmpfiles.d is the one booth.toml ships.
     const BoothConfig shipped = loadBoothConfig(kSource / "app/assets/booth.toml");
     EXPECT_EQ(shipped.sessions.directory, fs::path("/var/lib/avatarbooth/sessions"));

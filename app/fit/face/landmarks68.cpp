@@ -3,15 +3,19 @@
 #include "fit/face/landmarks68.h"
 
 #include "common/error.h"
+#include "fit/face/model_cache.h"
 #include "fit/face/quantized_shape_predictor.h"
 
 #include <dlib/image_processing.h>
 #include <dlib/image_processing/frontal_face_detector.h>
 #include <dlib/opencv/cv_image.h>
+#include <dlib/revision.h>
 #include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <sstream>
 
 namespace avatarbooth {
 
@@ -39,16 +43,54 @@ cv::Mat toGrey(const cv::Mat& bgr) {
     return grey;
 }
 
+// dlib makes its face detector by decompressing a string compiled into it, a quarter of a second of every start;
+// the detector's own serialisation (155 KB) reads in milliseconds. It depends only on dlib's version.
+dlib::frontal_face_detector frontalFaceDetector(const std::filesystem::path& cacheDir) {
+    if (cacheDir.empty()) return dlib::get_frontal_face_detector();
+    static constexpr CacheKind kKind{"face-detector", 1};
+    const std::string stamp = "dlib " + std::to_string(DLIB_MAJOR_VERSION) + "." + std::to_string(DLIB_MINOR_VERSION) +
+                              "." + std::to_string(DLIB_PATCH_VERSION) + " get_frontal_face_detector()";
+    const std::filesystem::path file = cacheDir / "frontal_face_detector.dlib";
+    std::string why;
+    if (const auto cache = CacheFile::open(file, kKind, stamp, why)) {
+        try {
+            const auto payload = cache->payload();
+            std::istringstream in(std::string(reinterpret_cast<const char*>(payload.data()), payload.size()));
+            dlib::frontal_face_detector detector;
+            dlib::deserialize(detector, in);
+            return detector;
+        } catch (const dlib::serialization_error& e) {
+            why = std::string("is not a detector dlib reads: ") + e.what();
+        }
+    }
+    if (!why.empty()) spdlog::info("{}: {}: making dlib's face detector again", file.string(), why);
+    dlib::frontal_face_detector detector = dlib::get_frontal_face_detector();
+    std::ostringstream out;
+    dlib::serialize(detector, out);
+    try {
+        const std::string bytes = out.str();
+        const std::string_view pieces[] = {bytes};
+        CacheFile::write(file, kKind, stamp, pieces);
+    } catch (const BoothError& e) {
+        spdlog::warn("face detector cache not written, so it is made again at every start: {}", e.what());
+    }
+    return detector;
+}
+
 }  // namespace
 
-LandmarkDetector::LandmarkDetector(const std::filesystem::path& model) : impl_(std::make_unique<Impl>()) {
-    impl_->detector = dlib::get_frontal_face_detector();
+LandmarkDetector::LandmarkDetector(const std::filesystem::path& model)
+    : LandmarkDetector(model, defaultModelCacheDir()) {}
+
+LandmarkDetector::LandmarkDetector(const std::filesystem::path& model, const std::filesystem::path& cacheDir)
+    : impl_(std::make_unique<Impl>()) {
+    impl_->detector = frontalFaceDetector(cacheDir);
     // Any readable file that is not a folder: a named pipe too (the kiosk's tests feed a model slowly, or never,
     // through one, to check that the booth does not wait for the load).
     if (!std::filesystem::exists(model) || std::filesystem::is_directory(model))
         throw BoothError(ErrorKind::BadConfig, model.string(),
                          "landmark model not found (install Debian's libdlib-data, or set [face] landmark_model)");
-    auto predictor = std::make_shared<const QuantizedShapePredictor>(model);
+    std::shared_ptr<const QuantizedShapePredictor> predictor = QuantizedShapePredictor::load(model, cacheDir);
     if (predictor->parts() != 68)
         throw BoothError(ErrorKind::BadConfig, model.string(),
                          "has " + std::to_string(predictor->parts()) + " landmarks, 68 expected");
@@ -61,7 +103,7 @@ LandmarkDetector::~LandmarkDetector() = default;
 
 std::unique_ptr<LandmarkDetector> LandmarkDetector::sharingModel() const {
     auto impl = std::make_unique<Impl>();
-    impl->detector = impl_->detector;  // a copy of the trained detector: cheaper than building it again (about 1 s)
+    impl->detector = impl_->detector;  // a copy of the trained detector: cheaper than reading it again
     impl->predictor = impl_->predictor;
     return std::unique_ptr<LandmarkDetector>(new LandmarkDetector(std::move(impl)));
 }

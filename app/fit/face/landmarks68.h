@@ -22,10 +22,12 @@ struct FaceLandmarks {
 
 class LandmarkDetector {
 public:
-    // Loads dlib's HOG face detector and the shape predictor model (a 100 MB file, held in 33 MB; 1-2 s): do it
-    // once.
+    // Loads dlib's HOG face detector and the shape predictor model (a 100 MB file, held in 33 MB), both through
+    // their cache files in `cacheDir` (fit/face/model_cache.h; made at the first start, when the load takes about
+    // a second; empty: no cache), or defaultModelCacheDir() in the first form. Do it once.
     // Throws BoothError(BadConfig) naming the model file when it is missing or unreadable.
     explicit LandmarkDetector(const std::filesystem::path& shapePredictorModel);
+    LandmarkDetector(const std::filesystem::path& shapePredictorModel, const std::filesystem::path& cacheDir);
     ~LandmarkDetector();
     LandmarkDetector(const LandmarkDetector&) = delete;
     LandmarkDetector& operator=(const LandmarkDetector&) = delete;
