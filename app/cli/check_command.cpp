@@ -225,6 +225,18 @@ void checkLandmarkModel(const fs::path& model, Report& report) {
     }
 }
 
+// The base head the fit starts from: the operator's own, or the MakeHuman head the package installs.
+void checkBaseHead(const FitConfig& fit, Report& report) {
+    try {
+        const auto head = configuredBaseHead(fit);
+        const std::string where = fit.baseMesh.empty() ? findMakeHumanBaseHead().string() : fit.baseMesh.string();
+        report.ok("base head", where + ": " + std::to_string(head->mesh.vertexCount()) + " vertices, " +
+                                   std::to_string(head->modifiers ? head->modifiers->modifiers.size() : 0) + " modifiers");
+    } catch (const BoothError& e) {
+        report.fail("base head", e.what(), ErrorKind::BadConfig);
+    }
+}
+
 void checkStrings(const fs::path& configured, Report& report) {
     try {
         const fs::path file = configured.empty() ? StringTable::defaultFile() : configured;
@@ -285,6 +297,7 @@ void registerCheckCommand(CLI::App& app) {
         checkGpio(config.buttons, report);
         checkDisplay(config.display, report);
         checkLandmarkModel(config.fit.settings.landmarkModel, report);
+        checkBaseHead(config.fit, report);
         checkStrings(config.screen.stringsFile, report);
         checkSessions(config.sessions.directory, report);
 

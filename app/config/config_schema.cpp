@@ -328,8 +328,9 @@ void addFitKeys(std::vector<ConfigKey>& k) {
                      "dlib's 68-point shape predictor (Debian: libdlib-data). It was trained on iBUG 300-W, whose terms "
                      "exclude commercial use: a commercial booth needs a model trained on data it may use."));
     k.push_back(path("fit", "base_mesh", FIELD(fit.baseMesh),
-                     "Your own base head instead of the built-in one: a glb with UVs (`avatarbooth make-base-head -o "
-                     "DIR` writes the built-in pair to start from); \"\" = the built-in head."));
+                     "Your own base head instead of the MakeHuman head the booth ships: a glb with UVs (`avatarbooth "
+                     "make-base-head --from-makehuman DIR -o OUT` writes the shipped one to start from); \"\" = the "
+                     "MakeHuman head."));
     k.push_back(path("fit", "base_features", FIELD(fit.baseFeatures),
                      "The feature file of base_mesh; give both or neither."));
     k.push_back(enumChoice(

@@ -181,8 +181,10 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     for (const auto* features : {&base_.frontFeatures, &base_.sideFeatures})
         for (const auto& [name, v] : *features) out.featurePoints.emplace_back(name, out.fit.mesh.positions[v]);
     out.texture = runStep(out, control, FitStep::Texture, names, [&] {
-        return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture,
-                                 *textureTables_);
+        PhotoTexture t = textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask,
+                                           settings_.texture, *textureTables_);
+        if (!base_.skin.empty()) addBaseLayerDetail(t, base_.skin);
+        return t;
     });
     return out;
 }

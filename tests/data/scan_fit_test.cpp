@@ -56,12 +56,15 @@ double icpRms(std::vector<glm::dvec3> points, const std::vector<glm::dvec3>& sca
 
 }  // namespace
 
-// The bar is 3 % of head height; the fit must also come nearer the scan than the unfitted base head (1.65 %
-// measured), or it has learnt nothing from the photos. Measured: 1.59 %.
+// The bar is 3 % of head height; the fit must also come nearer the scan than the unfitted base head (the
+// product's, MakeHuman's), or it has learnt nothing from the photos. (measure.py's face-region figures, the issue's
+// measure of likeness, are in tests/data/likeness_data_test.cpp.)
 TEST(ScanFit, FittedHeadIsNearerTheScanThanTheBaseHead) {
     AVATARBOOTH_REQUIRE_SHARED_DATA();
     const fs::path dir = test::sharedData() / "scan_lee_perry_smith";
-    const FitPipeline pipeline{FitSettings{}};
+    if (findMakeHumanBaseHead().empty()) GTEST_SKIP() << "the MakeHuman base head was not built";
+    const auto product = productBaseHead();
+    const FitPipeline pipeline{FitSettings{}, *product};
     const FitPhotoFiles inputs{dir / "renders" / "LeePerrySmith_yaw+000_rgb.png", dir / "renders" / "LeePerrySmith_yaw+090_rgb.png", {}};
     static MeshRenderer renderer;
     const FitOutcome out = pipeline.fit(inputs);

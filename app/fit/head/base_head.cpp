@@ -62,8 +62,8 @@ std::vector<ContourVertex> findContourVertices(const Mesh& mesh, const glm::dvec
     const glm::dvec2 c = projectToView(centre, view);
     std::vector<ContourVertex> result;
     for (const double angle : anglesDeg) {
-        // The outline point on this ray: among the vertices within 4 degrees of it, the one furthest out, less how
-        // far it lies off the ray. A coarse mesh (the MakeHuman head's skull has vertices a centimetre apart) may have
+        // The outline point on this ray: among the vertices within 4 degrees of it, the one furthest out, less three
+        // times how far it lies off the ray. A coarse mesh (the MakeHuman head's skull has vertices a centimetre apart) may have
         // no vertex within a degree of the outline's crossing, and then the furthest vertex in a narrow wedge is one
         // inside the outline (on the side of the head for a side ray over the top).
         const double rad = angle * 3.14159265358979323846 / 180.0;
@@ -76,8 +76,8 @@ std::vector<ContourVertex> findContourVertices(const Mesh& mesh, const glm::dvec
             if (along <= 0.0) continue;
             const double across = std::abs(d.x * dir.y - d.y * dir.x);
             if (across > 0.07 * along + 1.0) continue;
-            if (along - across > best) {
-                best = along - across;
+            if (along - 3.0 * across > best) {
+                best = along - 3.0 * across;
                 bestVertex = i;
             }
         }

@@ -39,16 +39,17 @@ constexpr int kBodyMaterial = 0;
 constexpr int kRightEyeMaterial = 6, kLeftEyeMaterial = 7;
 
 // The 68 iBUG landmarks as hm08 vertices. Found by dlib's detector and predictor (the booth's own) on a front
-// render of the default human with its young_caucasian_male skin and painted eyes, each landmark taken to the
-// nearest vertex of the (kept, visible) body triangle under it; tests/data/makehuman_head_data_test.cpp renders the imported head
-// again and checks every vertex against a fresh detection.
+// render of the default human with its young_caucasian_male skin and painted eyes: each landmark taken to the nearest
+// body vertex that the front view sees (within 1.5 mm of the depth buffer there; the lids' and lips' inner vertices
+// lie behind). tests/data/makehuman_head_data_test.cpp renders the imported head and checks every one against a
+// fresh detection.
 constexpr std::array<std::uint32_t, 68> kIbugVertices = {
-    3740, 5327, 5176, 5206, 5299, 5227, 5223, 5221, 5296, 7616, 7619, 7595,
-    11849, 11851, 11713, 12010, 12366, 254, 225, 204, 180, 209, 6984, 6980,
+    3740, 5327, 5176, 5206, 5299, 5227, 5165, 5221, 5296, 7687, 7619, 7595,
+    7597, 11851, 11713, 12332, 12366, 254, 225, 204, 180, 209, 6984, 6980,
     6979, 6999, 7023, 133, 131, 164, 294, 320, 313, 317, 7076, 7082,
-    6779, 954, 1047, 69, 4862, 41, 6853, 6838, 7653, 11473, 11478, 11480,
-    3734, 447, 457, 467, 7219, 11954, 7249, 7239, 7241, 492, 486, 478,
-    847, 471, 474, 7228, 7197, 7710, 523, 514,
+    6779, 0, 6763, 69, 4862, 41, 6853, 7765, 6784, 11473, 11478, 11480,
+    3734, 447, 457, 467, 7219, 11954, 7189, 7239, 7241, 492, 486, 406,
+    437, 471, 474, 7228, 7197, 7279, 523, 514,
 };
 
 nlohmann::json readJson(const fs::path& file) {
@@ -334,7 +335,11 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
     for (const Quad& q : body.quads) {
         if (q.material == kRightEyeMaterial || q.material == kLeftEyeMaterial) kept.push_back(&q);
         else if (q.material == kBodyMaterial &&
-                 std::all_of(q.v.begin(), q.v.end(), [&](std::uint32_t v) { return human[v].y > options.neckCutDm; }))
+                 std::all_of(q.v.begin(), q.v.end(), [&](std::uint32_t v) {
+                     // The cut rises to the sides, where the neck widens into the shoulders, so that it leaves a
+                     // round neck and no tongues of trapezius.
+                     return human[v].y > options.neckCutDm + 1.5 * std::max(0.0, std::abs(human[v].x) - 0.5);
+                 }))
             kept.push_back(&q);
     }
 

@@ -21,8 +21,8 @@ struct MakeHumanImportOptions {
     // The skin whose texture becomes the base layer (a folder under public/data/skins/).
     std::string skin = "young_caucasian_male";
     int textureSize = 1024;
-    // The neck is cut where MakeHuman's default human is this high (its own unit, decimetres): about 40 mm under
-    // the chin, above the shoulders' slope.
+    // The neck is cut where MakeHuman's default human is this high (its own unit, decimetres) at the front and
+    // back, about 40 mm under the chin, rising to the sides beyond 5 cm from the midline.
     double neckCutDm = 5.9;
 };
 

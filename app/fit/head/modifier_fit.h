@@ -27,7 +27,7 @@ struct ModifierTarget {
 struct ModifierFitOptions {
     // lambda, in square millimetres per unit weight squared: a modifier at full weight must remove this much squared
     // error to be worth it.
-    double regularisation = 30.0;
+    double regularisation = 300.0;
     int sweeps = 400;  // projected Gauss-Seidel sweeps over the normal equations
     // Modifier groups held at 0: the ears, which no photo measurement sees (the outline rays pass above and below
     // them), would otherwise be bent to fit rays that meet hair.

@@ -551,4 +551,31 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     return out;
 }
 
+void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& skin) {
+    if (texture.texture.empty() || skin.empty()) return;
+    cv::Mat layer;
+    cv::resize(skin, layer, texture.texture.size(), 0, 0, cv::INTER_AREA);
+    layer.convertTo(layer, CV_32FC3);
+    cv::Mat smooth;
+    // The blur's width: detail finer than about 1/40 of the texture (a crease, an ear's fold) passes.
+    const double sigma = texture.texture.cols / 80.0;
+    cv::GaussianBlur(layer, smooth, cv::Size(), sigma);
+    const cv::Mat detail = layer - smooth;
+    // Feathered: the made-up texels take all of it, those a photo saw none, with a soft edge between.
+    cv::Mat filled;
+    cv::compare(texture.source, PhotoTexture::Filled, filled, cv::CMP_EQ);
+    cv::Mat weight;
+    filled.convertTo(weight, CV_32F, 1.0 / 255.0);
+    cv::GaussianBlur(weight, weight, cv::Size(), sigma);
+    cv::Mat colour;
+    texture.texture.convertTo(colour, CV_32FC3);
+    std::vector<cv::Mat> d(3);
+    cv::split(detail, d);
+    for (auto& c : d) c = c.mul(weight);
+    cv::Mat weighted;
+    cv::merge(d, weighted);
+    colour += weighted;
+    colour.convertTo(texture.texture, CV_8UC3);
+}
+
 }  // namespace avatarbooth

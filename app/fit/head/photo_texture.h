@@ -68,6 +68,12 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
 PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
                                const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options = {});
 
+// Where no photo saw the head (texels the fill made up: under the chin, in and behind the ears, parts of the top),
+// the base head's skin layer lends its detail: its difference from its own blur, added to the filled colour, so
+// that ears, creases and lips keep their shading while the colour stays the one the fill continued from the photos
+// (hair where the photos showed hair). `skin`: BGR on the same UVs, any size.
+void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& skin);
+
 // Fills texels where weight == 0 from the others, coarse to fine (pull-push); texels of partial weight blend
 // with the fill. colour: CV_32FC3, weight: CV_32F (all 1 afterwards).
 void pullPushFill(cv::Mat& colour, cv::Mat& weight);
