@@ -79,7 +79,7 @@ auto runStep(Out& out, const FitControl& control, FitStep step, const FitPhotoNa
 FitPipeline::FitPipeline(FitSettings settings, const BaseHead& base) : settings_(std::move(settings)), base_(base) {
     const auto t0 = Clock::now();
     detector_ = std::make_unique<LandmarkDetector>(settings_.landmarkModel);
-    textureTables_ = std::make_shared<const TextureTables>(base_.mesh, settings_.texture);
+    textureTables_ = std::make_shared<const TextureTables>(base_.mesh, settings_.texture, base_.skin);
     frontalCheck_ = std::make_shared<FrontalFaceCheck>();
     modelLoadSeconds_ = secondsSince(t0);
 }
@@ -181,10 +181,8 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     for (const auto* features : {&base_.frontFeatures, &base_.sideFeatures})
         for (const auto& [name, v] : *features) out.featurePoints.emplace_back(name, out.fit.mesh.positions[v]);
     out.texture = runStep(out, control, FitStep::Texture, names, [&] {
-        PhotoTexture t = textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask,
-                                           settings_.texture, *textureTables_);
-        if (!base_.skin.empty()) addBaseLayerDetail(t, base_.skin);
-        return t;
+        return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture,
+                                 *textureTables_);
     });
     return out;
 }

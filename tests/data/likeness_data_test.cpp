@@ -4,6 +4,7 @@
 // RMS of the scan-to-fit surface distance at 46.7 mm per scan unit), with the unfitted MakeHuman head beside it.
 // folds.py counts the fit's triangles turned over against the base head. The figures are printed; the test holds
 // the fit to what must be true of any fit worth having: nearer the scan than no photo at all, and without a fold.
+// (Debian's /usr/bin/python3 with python3-numpy and python3-scipy: another python3 on the PATH may lack them.)
 #include "test_paths.h"
 
 #include "booth/session_folder.h"
@@ -39,7 +40,7 @@ TEST(Likeness, ScanFaceRegionNearerThanTheUnfittedHeadAndNoFolds) {
     const fs::path baseDir = findMakeHumanBaseHead();
     if (baseDir.empty()) GTEST_SKIP() << "the MakeHuman base head was not built";
     if (!fs::is_regular_file(likenessTools() / "measure.py")) GTEST_SKIP() << "no " << likenessTools() / "measure.py";
-    if (run("python3 -c 'import numpy, scipy' 2>/dev/null") != 0) GTEST_SKIP() << "python3-numpy/-scipy missing";
+    if (run("/usr/bin/python3 -c 'import numpy, scipy' 2>/dev/null") != 0) GTEST_SKIP() << "python3-numpy/-scipy missing";
 
     const fs::path scan = test::sharedData() / "scan_lee_perry_smith";
     const auto base = productBaseHead();
@@ -56,7 +57,7 @@ TEST(Likeness, ScanFaceRegionNearerThanTheUnfittedHeadAndNoFolds) {
         foldsArgs += " " + quoted(out / "avatar.glb");
     }
     const fs::path json = work / "measure.json";
-    ASSERT_EQ(run("python3 " + quoted(likenessTools() / "measure.py") + " --scan " + quoted(scan / "LeePerrySmith.obj") +
+    ASSERT_EQ(run("/usr/bin/python3 " + quoted(likenessTools() / "measure.py") + " --scan " + quoted(scan / "LeePerrySmith.obj") +
                   " --scan-mm-per-unit 46.7 --scan-landmarks " + quoted(likenessTools() / "lps_landmarks68.txt") + fits +
                   " --fit " + quoted(baseDir / "base_head.glb") + " --name base > " + quoted(json)),
               0);
@@ -72,7 +73,7 @@ TEST(Likeness, ScanFaceRegionNearerThanTheUnfittedHeadAndNoFolds) {
     }
     // folds.py prints the total of triangles turned over against the base head.
     const fs::path folds = work / "folds.txt";
-    ASSERT_EQ(run("python3 " + quoted(likenessTools() / "folds.py") + " " + quoted(baseDir / "base_head.glb") + foldsArgs +
+    ASSERT_EQ(run("/usr/bin/python3 " + quoted(likenessTools() / "folds.py") + " " + quoted(baseDir / "base_head.glb") + foldsArgs +
                   " > " + quoted(folds)),
               0);
     std::ifstream f(folds);

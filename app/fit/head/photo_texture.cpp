@@ -263,10 +263,20 @@ const Mesh& withUvs(const Mesh& mesh) {
 
 }  // namespace
 
-TextureTables::TextureTables(const Mesh& base, const PhotoTextureOptions& options)
+TextureTables::TextureTables(const Mesh& base, const PhotoTextureOptions& options, const cv::Mat& skin)
     : vertices_(withUvs(base).uvs.size()), triangles_(base.triangles.size()),
       full_(mapTexels(base, cv::Size(checkedTextureSize(options), options.size))),
-      half_(mapTexels(base, cv::Size((options.size + 1) / 2, (options.size + 1) / 2))) {}
+      half_(mapTexels(base, cv::Size((options.size + 1) / 2, (options.size + 1) / 2))) {
+    if (skin.empty()) return;
+    // The skin layer's detail: its difference from its own blur (finer than about 1/40 of the texture: a crease, an
+    // ear's fold), made once here because the wide blur is the costly part.
+    cv::Mat layer;
+    cv::resize(skin, layer, cv::Size(options.size, options.size), 0, 0, cv::INTER_AREA);
+    layer.convertTo(layer, CV_32FC3);
+    cv::Mat smooth;
+    cv::GaussianBlur(layer, smooth, cv::Size(), options.size / 80.0);
+    skinDetail_ = layer - smooth;
+}
 
 PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
                                const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options) {
@@ -548,33 +558,25 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
         seen += seenCount[s];
     }
     out.seenFraction = covered > 0 ? static_cast<double>(seen) / covered : 0.0;
+    addBaseLayerDetail(out, tables.skinDetail());
     return out;
 }
 
-void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& skin) {
-    if (texture.texture.empty() || skin.empty()) return;
-    cv::Mat layer;
-    cv::resize(skin, layer, texture.texture.size(), 0, 0, cv::INTER_AREA);
-    layer.convertTo(layer, CV_32FC3);
-    cv::Mat smooth;
-    // The blur's width: detail finer than about 1/40 of the texture (a crease, an ear's fold) passes.
-    const double sigma = texture.texture.cols / 80.0;
-    cv::GaussianBlur(layer, smooth, cv::Size(), sigma);
-    const cv::Mat detail = layer - smooth;
-    // Feathered: the made-up texels take all of it, those a photo saw none, with a soft edge between.
-    cv::Mat filled;
+void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& detail) {
+    if (texture.texture.empty() || detail.empty() || detail.size() != texture.texture.size()) return;
+    // Feathered: the made-up texels take all of it, those a photo saw none, with a soft edge between (the mask
+    // blurred at an eighth of the size: the edge needs no more).
+    cv::Mat filled, small, weight;
     cv::compare(texture.source, PhotoTexture::Filled, filled, cv::CMP_EQ);
-    cv::Mat weight;
-    filled.convertTo(weight, CV_32F, 1.0 / 255.0);
-    cv::GaussianBlur(weight, weight, cv::Size(), sigma);
+    cv::resize(filled, small, cv::Size(), 0.125, 0.125, cv::INTER_AREA);
+    small.convertTo(small, CV_32F, 1.0 / 255.0);
+    cv::GaussianBlur(small, small, cv::Size(), 1.5);
+    cv::resize(small, weight, texture.texture.size(), 0, 0, cv::INTER_LINEAR);
     cv::Mat colour;
     texture.texture.convertTo(colour, CV_32FC3);
-    std::vector<cv::Mat> d(3);
-    cv::split(detail, d);
-    for (auto& c : d) c = c.mul(weight);
-    cv::Mat weighted;
-    cv::merge(d, weighted);
-    colour += weighted;
+    cv::Mat weight3;
+    cv::merge(std::vector<cv::Mat>{weight, weight, weight}, weight3);
+    colour += detail.mul(weight3);
     colour.convertTo(texture.texture, CV_8UC3);
 }
 

@@ -48,16 +48,20 @@ struct PhotoTexture {
 class TextureTables {
 public:
     // Throws BoothError(Internal) for a size under 16 texels.
-    TextureTables(const Mesh& base, const PhotoTextureOptions& options);
+    // `skin`: the base head's skin layer on its UVs (BaseHead::skin), or empty.
+    TextureTables(const Mesh& base, const PhotoTextureOptions& options, const cv::Mat& skin = {});
     int size() const { return full_.size.width; }
     const TexelMap& full() const { return full_; }
     const TexelMap& half() const { return half_; }
     // Whether `mesh` has the UV layout the tables were made for (same vertex and triangle counts).
     bool fits(const Mesh& mesh) const { return mesh.uvs.size() == vertices_ && mesh.triangles.size() == triangles_; }
+    // The skin layer's fine detail at the texture's size (CV_32FC3), or empty: see addBaseLayerDetail.
+    const cv::Mat& skinDetail() const { return skinDetail_; }
 
 private:
     std::size_t vertices_, triangles_;
     TexelMap full_, half_;
+    cv::Mat skinDetail_;
 };
 
 // `tables`: made for the fitted mesh's base head and options.size (BoothError Internal otherwise).
@@ -69,10 +73,10 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
                                const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options = {});
 
 // Where no photo saw the head (texels the fill made up: under the chin, in and behind the ears, parts of the top),
-// the base head's skin layer lends its detail: its difference from its own blur, added to the filled colour, so
-// that ears, creases and lips keep their shading while the colour stays the one the fill continued from the photos
-// (hair where the photos showed hair). `skin`: BGR on the same UVs, any size.
-void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& skin);
+// the base head's skin layer lends its detail (TextureTables::skinDetail, added by textureFromPhotos), so that ears,
+// creases and lips keep their shading while the colour stays the one the fill continued from the photos (hair where
+// the photos showed hair).
+void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& detail);
 
 // Fills texels where weight == 0 from the others, coarse to fine (pull-push); texels of partial weight blend
 // with the fill. colour: CV_32FC3, weight: CV_32F (all 1 afterwards).
