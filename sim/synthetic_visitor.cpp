@@ -170,27 +170,32 @@ cv::Mat makeBackdrop(cv::Size size, unsigned seed) {
     return backdrop;
 }
 
-// Shoulders and chest under the neck, as a polygon in head space drawn with the camera (a shirt).
-void drawShoulders(cv::Mat& image, const RenderCamera& camera, bool side) {
+// Shoulders and chest under the neck, as a polygon in head space drawn with the camera (a shirt): from just above
+// where the head mesh's neck ends (the head covers the overlap), out and down past the image's bottom.
+void drawShoulders(cv::Mat& image, const RenderCamera& camera, bool side, const SyntheticPhotoSetup& setup) {
+    const SyntheticNeck& neck = setup.neck;
+    const double y = neck.baseY, x = neck.halfWidth;
     std::vector<glm::dvec3> outline;
     if (!side) {
-        outline = {{-48, -150, 0}, {-70, -190, 0}, {-185, -215, 0}, {-215, -300, 0}, {-230, -900, 0},
-                   {230, -900, 0}, {215, -300, 0},  {185, -215, 0},  {70, -190, 0},   {48, -150, 0}};
+        outline = {{-x, y, 0},          {-x - 22, y - 40, 0}, {-185, y - 65, 0}, {-215, y - 150, 0}, {-230, -900, 0},
+                   {230, -900, 0},      {215, y - 150, 0},    {185, y - 65, 0},  {x + 22, y - 40, 0}, {x, y, 0}};
     } else {
-        outline = {{0, -150, 40}, {0, -200, 75}, {0, -260, 110}, {0, -900, 120},
-                   {0, -900, -130}, {0, -250, -125}, {0, -190, -80}, {0, -150, -60}};
+        outline = {{0, y, neck.frontZ},        {0, y - 50, neck.frontZ + 35}, {0, y - 110, neck.frontZ + 70},
+                   {0, -900, neck.frontZ + 80}, {0, -900, neck.backZ - 70},   {0, y - 100, neck.backZ - 65},
+                   {0, y - 40, neck.backZ - 20}, {0, y, neck.backZ}};
     }
     std::vector<cv::Point> poly;
     for (const auto& p : outline) {
         const glm::dvec2 px = camera.project(p);
         poly.emplace_back(static_cast<int>(std::lround(px.x - 0.5)), static_cast<int>(std::lround(px.y - 0.5)));
     }
-    cv::fillPoly(image, std::vector<std::vector<cv::Point>>{poly}, cv::Scalar(96, 110, 40), cv::LINE_AA);
+    cv::fillPoly(image, std::vector<std::vector<cv::Point>>{poly}, setup.shirt, cv::LINE_AA);
 }
 
-cv::Mat composite(const cv::Mat& backdrop, const RenderResult& head, const RenderCamera& camera, bool side) {
+cv::Mat composite(const cv::Mat& backdrop, const RenderResult& head, const RenderCamera& camera, bool side,
+                  const SyntheticPhotoSetup& setup) {
     cv::Mat photo = backdrop.clone();
-    drawShoulders(photo, camera, side);
+    drawShoulders(photo, camera, side, setup);
     for (int y = 0; y < photo.rows; ++y)
         for (int x = 0; x < photo.cols; ++x) {
             const double a = head.mask.at<unsigned char>(y, x) / 255.0;
@@ -205,33 +210,45 @@ cv::Mat composite(const cv::Mat& backdrop, const RenderResult& head, const Rende
 
 }  // namespace
 
+void photographSyntheticHead(SyntheticVisitor& v, const BaseHead& base, const glm::dvec3& earHole, MeshRenderer& renderer,
+                             const SyntheticPhotoSetup& setup) {
+    const int w = setup.imageSize.width, h = setup.imageSize.height;
+    v.frontCamera = RenderCamera::orthographic(setup.target + glm::dvec3(0, 0, 800), setup.target, {0, 1, 0},
+                                               setup.mmPerPixel, w, h);
+    const double sideSign = setup.sideNoseImageRight ? -1.0 : 1.0;  // camera on the subject's right: nose right
+    v.sideCamera = RenderCamera::orthographic(setup.target + glm::dvec3(sideSign * 800, 0, 0), setup.target, {0, 1, 0},
+                                              setup.mmPerPixel, w, h);
+    v.frontCamera.background = v.sideCamera.background = cv::Scalar(0, 0, 0);
+    v.frontCamera.lit = v.sideCamera.lit = setup.lit;
+
+    renderer.upload(v.truthMesh, v.texture);
+    v.background = makeBackdrop(setup.imageSize, setup.backdropSeed);
+    v.front = composite(v.background, renderer.render(v.frontCamera), v.frontCamera, false, setup);
+    v.side = composite(v.background, renderer.render(v.sideCamera), v.sideCamera, true, setup);
+
+    // OpenCV / dlib pixel convention: pixel centres at integer coordinates.
+    const auto toPixel = [](const glm::dvec2& p) { return cv::Point2d(p.x - 0.5, p.y - 0.5); };
+    v.frontLandmarks.clear();
+    v.sideLandmarks.clear();
+    for (const auto& [name, vertex] : base.frontFeatures)
+        v.frontLandmarks[name] = toPixel(v.frontCamera.project(v.truthMesh.positions[vertex]));
+    for (const auto& [name, vertex] : base.sideFeatures)
+        v.sideLandmarks[name] = toPixel(v.sideCamera.project(v.truthMesh.positions[vertex]));
+    v.sideLandmarks["ear_hole"] = toPixel(v.sideCamera.project(earHole));
+}
+
 SyntheticVisitor makeSyntheticVisitor(const BaseHead& base, MeshRenderer& renderer, const SyntheticVisitorOptions& options) {
     SyntheticVisitor v;
     v.texture = paintSyntheticFace(base, options.textureSize);
     v.truthMesh = base.mesh;
     for (auto& p : v.truthMesh.positions) p = syntheticWarp(p, options.seed);
-
-    const int w = options.imageSize.width, h = options.imageSize.height;
-    const glm::dvec3 target(0.0, -45.0, 0.0);  // the head sits in the upper middle of the frame, shoulders below
-    v.frontCamera = RenderCamera::orthographic(target + glm::dvec3(0, 0, 800), target, {0, 1, 0}, options.mmPerPixel, w, h);
-    const double sideSign = options.sideNoseImageRight ? -1.0 : 1.0;  // camera on the subject's right: nose right
-    v.sideCamera = RenderCamera::orthographic(target + glm::dvec3(sideSign * 800, 0, 0), target, {0, 1, 0},
-                                              options.mmPerPixel, w, h);
-    v.frontCamera.background = v.sideCamera.background = cv::Scalar(0, 0, 0);
-    v.frontCamera.lit = v.sideCamera.lit = options.lit;
-
-    renderer.upload(v.truthMesh, v.texture);
-    v.background = makeBackdrop(options.imageSize, options.seed);
-    v.front = composite(v.background, renderer.render(v.frontCamera), v.frontCamera, false);
-    v.side = composite(v.background, renderer.render(v.sideCamera), v.sideCamera, true);
-
-    // OpenCV / dlib pixel convention: pixel centres at integer coordinates.
-    const auto toPixel = [](const glm::dvec2& p) { return cv::Point2d(p.x - 0.5, p.y - 0.5); };
-    for (const auto& [name, vertex] : base.frontFeatures)
-        v.frontLandmarks[name] = toPixel(v.frontCamera.project(v.truthMesh.positions[vertex]));
-    for (const auto& [name, vertex] : base.sideFeatures)
-        v.sideLandmarks[name] = toPixel(v.sideCamera.project(v.truthMesh.positions[vertex]));
-    v.sideLandmarks["ear_hole"] = toPixel(v.sideCamera.project(syntheticWarp(base.earHoleCentre, options.seed)));
+    SyntheticPhotoSetup setup;
+    setup.mmPerPixel = options.mmPerPixel;
+    setup.imageSize = options.imageSize;
+    setup.sideNoseImageRight = options.sideNoseImageRight;
+    setup.lit = options.lit;
+    setup.backdropSeed = options.seed;
+    photographSyntheticHead(v, base, syntheticWarp(base.earHoleCentre, options.seed), renderer, setup);
     return v;
 }
 

@@ -5,7 +5,8 @@
 // longer or shorter nose, a fuller back of the head, a longer chin) whose form differs from the fit's RBF warp,
 // so that the fit cannot recover it exactly by construction. Its face is painted procedurally in texture space
 // (skin, hair cap, brows, eyes with iris and pupil, lips, nostrils) and lit by the renderer, well enough that
-// dlib's face detector and landmark predictor find it.
+// dlib's face detector and landmark predictor find it. sim/makehuman_visitor.h makes MakeHuman people and takes
+// their photos the same way (photographSyntheticHead).
 #pragma once
 
 #include "fit/head/base_head.h"
@@ -40,6 +41,33 @@ struct SyntheticVisitor {
     std::map<std::string, cv::Point2d> frontLandmarks;  // ibug_00 .. ibug_67
     std::map<std::string, cv::Point2d> sideLandmarks;   // profile names (nose_tip, chin, ...)
 };
+
+// Where the head mesh's neck ends (head space, millimetres): the photos draw a shirt from there down. The defaults
+// are the built-in head's.
+struct SyntheticNeck {
+    double baseY = -150.0;     // the shirt's top edge: above the neck mesh's lowest vertices, so that no gap shows
+    double halfWidth = 48.0;   // of the neck there (front view)
+    double frontZ = 40.0, backZ = -60.0;  // the neck's front and back there (side view)
+};
+
+// How the synthetic photos are taken: orthographic front and side views of the head on a cloth backdrop, shoulders
+// below.
+struct SyntheticPhotoSetup {
+    double mmPerPixel = 0.6;
+    cv::Size imageSize{972, 720};
+    bool sideNoseImageRight = true;
+    bool lit = true;
+    unsigned backdropSeed = 1;           // the backdrop's folds
+    glm::dvec3 target{0.0, -45.0, 0.0};  // at the image centre: the head in the upper middle, shoulders below
+    SyntheticNeck neck;
+    cv::Scalar shirt{96, 110, 40};       // BGR
+};
+
+// Renders v.truthMesh with v.texture from the front and the side, composites both on the backdrop (v.front, v.side,
+// v.background, the cameras) and projects the ground truth: base's feature vertices on v.truthMesh (same
+// topology), and `earHole` (head space) as the side photo's "ear_hole".
+void photographSyntheticHead(SyntheticVisitor& v, const BaseHead& base, const glm::dvec3& earHole, MeshRenderer& renderer,
+                             const SyntheticPhotoSetup& setup);
 
 // The warp applied to base-head points for a given seed.
 glm::dvec3 syntheticWarp(const glm::dvec3& p, unsigned seed);

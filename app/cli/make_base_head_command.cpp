@@ -1,11 +1,12 @@
 // `avatarbooth make-base-head -o DIR` and `avatarbooth make-visitor -o DIR`: the built-in base head and the
-// synthetic visitor, written out to study, edit, or feed to `fit`.
+// synthetic visitors (the test head warped, or a MakeHuman person), written out to study, edit, or feed to `fit`.
 #include "cli/commands.h"
 
 #include "common/atomic_output.h"
 #include "fit/export/glb.h"
 #include "fit/head/base_head.h"
 #include "fit/head/makehuman_import.h"
+#include "sim/makehuman_visitor.h"
 #include "sim/synthetic_visitor.h"
 
 #include <iostream>
@@ -54,16 +55,35 @@ void registerMakeVisitorCommand(CLI::App& app) {
         std::string out;
         SyntheticVisitorOptions visitor;
         bool noseLeft = false;
+        bool makehuman = false;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("-o,--output", o->out, "Output folder")->required();
-    cmd->add_option("--seed", o->visitor.seed, "Which visitor (0 = the base head itself)")->capture_default_str();
+    cmd->add_option("--seed", o->visitor.seed,
+                    "Which visitor (the test head: 0 = the base head itself; --makehuman: which person)")
+        ->capture_default_str();
     cmd->add_flag("--nose-left", o->noseLeft, "Side photo with the nose pointing image-left");
+    cmd->add_flag("--makehuman", o->makehuman,
+                  "A MakeHuman person (random modifiers, skin, hair, eyes) on the product's base head, instead of the "
+                  "warped test head; truth/person.json says who");
     cmd->callback([o] {
         o->visitor.sideNoseImageRight = !o->noseLeft;
         MeshRenderer renderer;
-        const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, o->visitor);
         StagedDirectory dir(o->out, "truth");
+        if (o->makehuman) {
+            const auto base = productBaseHead();
+            MakeHumanVisitorOptions options;
+            options.seed = o->visitor.seed;
+            options.sideNoseImageRight = o->visitor.sideNoseImageRight;
+            const MakeHumanVisitor visitor = makeMakeHumanVisitor(*base, renderer, options);
+            writeMakeHumanVisitorFolder(visitor, *base, dir.staging());
+            dir.commit();
+            const MakeHumanPerson& p = visitor.person;
+            std::cout << "MakeHuman visitor " << options.seed << " (" << p.age << " " << p.ethnicity << " " << p.sex
+                      << ", hair " << p.hair << ", eyes " << p.eyes << ") written to " << o->out << "\n";
+            return;
+        }
+        const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, o->visitor);
         writeSyntheticVisitorFolder(visitor, dir.staging());
         dir.commit();
         std::cout << "synthetic visitor " << o->visitor.seed << " written to " << o->out << "\n";
