@@ -572,12 +572,16 @@ void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& detail) {
     small.convertTo(small, CV_32F, 1.0 / 255.0);
     cv::GaussianBlur(small, small, cv::Size(), 1.5);
     cv::resize(small, weight, texture.texture.size(), 0, 0, cv::INTER_LINEAR);
-    cv::Mat colour;
-    texture.texture.convertTo(colour, CV_32FC3);
-    cv::Mat weight3;
-    cv::merge(std::vector<cv::Mat>{weight, weight, weight}, weight3);
-    colour += detail.mul(weight3);
-    colour.convertTo(texture.texture, CV_8UC3);
+    // One pass, touching only the texels the fill made up (most of the texture was seen and stays as it is).
+    for (int y = 0; y < weight.rows; ++y) {
+        const float* w = weight.ptr<float>(y);
+        const cv::Vec3f* d = detail.ptr<cv::Vec3f>(y);
+        cv::Vec3b* t = texture.texture.ptr<cv::Vec3b>(y);
+        for (int x = 0; x < weight.cols; ++x) {
+            if (w[x] <= 0.0f) continue;
+            for (int c = 0; c < 3; ++c) t[x][c] = cv::saturate_cast<unsigned char>(t[x][c] + w[x] * d[x][c]);
+        }
+    }
 }
 
 }  // namespace avatarbooth
