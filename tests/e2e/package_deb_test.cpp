@@ -87,7 +87,12 @@ TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
                              "./usr/lib/sysusers.d/avatarbooth.conf", "./usr/lib/udev/rules.d/60-avatarbooth.rules",
                              "./usr/share/avatarbooth/firmware/avatarbooth-overlay.dts",
                              "./usr/share/avatarbooth/firmware/config.txt.fragment",
-                             "./usr/share/doc/avatarbooth/README.md"})
+                             "./usr/share/doc/avatarbooth/README.md",
+                             // the MakeHuman base head the build made
+                             "./usr/share/avatarbooth/base_head/base_head.glb",
+                             "./usr/share/avatarbooth/base_head/base_head.features.json",
+                             "./usr/share/avatarbooth/base_head/base_head.modifiers.bin",
+                             "./usr/share/avatarbooth/base_head/base_head.skin.png"})
         EXPECT_NE(r.output.find(std::string(path) + "\n"), std::string::npos) << path << " not in the package";
 
     // Unpacked into a scratch root; the binary found there runs and finds its own strings file and config.
@@ -122,6 +127,9 @@ TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
     EXPECT_NE(message["strings"].find((root / "usr/share/avatarbooth/strings.toml").string()), std::string::npos)
         << message["strings"];
     EXPECT_EQ(last["landmarks"], "OK") << message["landmarks"];
+    EXPECT_EQ(last["base head"], "OK") << message["base head"];
+    EXPECT_NE(message["base head"].find((root / "usr/share/avatarbooth/base_head").string()), std::string::npos)
+        << message["base head"];
     EXPECT_EQ(last["sessions"], "OK") << message["sessions"];
     // The shipped config says "auto" everywhere: on a machine without the hardware, warnings and exit code 0.
     EXPECT_EQ(r.exitCode, report.at("failures").get<int>() == 0 ? 0 : 8) << r.output;
