@@ -276,7 +276,7 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         const auto addFrontContour = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) {
             frontT.add(scaled, name, v, target, &scaledNormals);
         };
-        const auto addSide = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) {
+        const auto addSideContour = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) {
             sideT.add(scaled, name, v, target, &scaledNormals);
         };
         for (const int k : options.frontLandmarks) {
@@ -313,7 +313,7 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
             const cv::Point2d dir(p.z - earHead.x, -(p.y - earHead.y));
             const cv::Point2d hit = outlineCrossing(sideMask, earCanonical, dir, "side");
             fit.sideRays.emplace_back(mirrorPoint(earCanonical, sideWidth, mirror), mirrorPoint(hit, sideWidth, mirror));
-            addSide("side_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, sideCanonical.toHead(hit));
+            addSideContour("side_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, sideCanonical.toHead(hit));
         }
 
         if (!base.modifiers || round == options.modifierRounds) break;
