@@ -65,8 +65,11 @@ TEST(Folds, UnfoldLeavesNoFoldAndKeepsTheRest) {
             EXPECT_DOUBLE_EQ(after.positions[v].y, b.y + 3.0);
             EXPECT_DOUBLE_EQ(after.positions[v].x, b.x);
         }
-        for (std::size_t u = v + 1; u < after.positions.size(); ++u)
-            if (before.positions[u] == b) EXPECT_EQ(after.positions[u], after.positions[v]);
+        for (std::size_t u = v + 1; u < after.positions.size(); ++u) {
+            if (before.positions[u] == b) {
+                EXPECT_EQ(after.positions[u], after.positions[v]);
+            }
+        }
     }
 }
 
