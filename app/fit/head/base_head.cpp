@@ -174,12 +174,18 @@ BaseHead loadBaseHead(const std::filesystem::path& meshGlb, const std::filesyste
     return head;
 }
 
+// The build tree's base_head folder, told by app/CMakeLists.txt to this file alone (a build that compiles this file
+// on its own, as the fuzz targets do, has none).
+#ifndef AVATARBOOTH_BUILD_BASE_HEAD_DIR
+#define AVATARBOOTH_BUILD_BASE_HEAD_DIR ""
+#endif
+
 std::filesystem::path findMakeHumanBaseHead() {
     namespace fs = std::filesystem;
     std::vector<fs::path> places;
     if (const char* env = std::getenv("AVATARBOOTH_ASSET_DIR"); env && *env) places.push_back(fs::path(env) / "base_head");
     if (const fs::path exe = executableDir(); !exe.empty()) places.push_back(exe.parent_path() / "share/avatarbooth/base_head");
-    places.emplace_back(AVATARBOOTH_BUILD_BASE_HEAD_DIR);  // this build's own (make-base-head runs at build time)
+    if (*AVATARBOOTH_BUILD_BASE_HEAD_DIR) places.emplace_back(AVATARBOOTH_BUILD_BASE_HEAD_DIR);  // made at build time
     places.emplace_back("/usr/share/avatarbooth/base_head");
     for (const auto& p : places) {
         std::error_code ec;
