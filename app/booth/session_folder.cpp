@@ -55,6 +55,7 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
     report["rbf"] = {{"kernel", rbfKernelName(o.rbf.kernel)}, {"unit_mm", o.rbf.unitMm},
                      {"gaussian_sigma", o.rbf.gaussianSigma}, {"regularisation", o.rbf.regularisation}};
     report["axis_scale"] = {o.fit.axisScale.x, o.fit.axisScale.y, o.fit.axisScale.z};
+    report["measured_extents"] = {o.fit.measuredExtents.x, o.fit.measuredExtents.y, o.fit.measuredExtents.z};
     report["mm_per_pixel"] = {{"front", o.fit.front.mmPerPixel}, {"side", o.fit.side.mmPerPixel}};
     report["texture_seen_fraction"] = o.texture.seenFraction;
     report["model_load_seconds"] = o.modelLoadSeconds;

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 namespace avatarbooth {
@@ -99,6 +100,56 @@ TEST(ModifierFit, RegularisationPullsTowardsTheAverage) {
         previous = sum;
     }
     EXPECT_LT(previous, 0.05);  // at a huge lambda the head stays the average one
+}
+
+// An outline target counts along its normal only: moved along the outline (here the front view's y), it still gives
+// the true weights, and the modifier is free to move the vertex along the outline.
+TEST(ModifierFit, OutlineTargetsCountAlongTheirNormalOnly) {
+    const Problem p = makeProblem();
+    const std::vector<double> truth = {0.3, 0.7, 0.2, 0.5};
+    auto targets = targetsFor(p, truth, glm::dvec3(1.0), glm::dvec3(0.0), glm::dvec3(0.0));
+    for (auto& t : targets)
+        if (t.view == View::Front) {
+            t.normal = {1.0, 0.0};
+            t.weight = {1.0, 0.0};
+            t.target.y += 9.0;  // anywhere along the outline
+        }
+    ModifierFitOptions o;
+    o.regularisation = 1e-9;
+    o.robustMm = 0.0;
+    o.sweeps = 5000;
+    const ModifierFit f = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
+    for (std::size_t k = 0; k < truth.size(); ++k) EXPECT_NEAR(f.weights[k], truth[k], 1e-5) << k;
+    // The same targets as points pull the front y by 9 mm: the weights go wrong.
+    for (auto& t : targets) {
+        t.normal = glm::dvec2(0.0);
+        t.weight = glm::dvec2(1.0);
+    }
+    const ModifierFit g = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
+    EXPECT_GT(std::abs(g.weights[1] - truth[1]) + std::abs(g.translation.y), 1.0);
+}
+
+// One misplaced point (30 mm off) among exact ones: the Huber weights leave the modifiers near the truth, where plain
+// least squares lets it bend them.
+TEST(ModifierFit, RobustWeightsKeepAMisplacedPointFromBendingTheHead) {
+    const Problem p = makeProblem();
+    const std::vector<double> truth = {0.3, 0.7, 0.2, 0.5};
+    auto targets = targetsFor(p, truth, glm::dvec3(1.0), glm::dvec3(0.0), glm::dvec3(0.0));
+    targets[6].target += glm::dvec2(30.0, -30.0);
+    const auto error = [&](double robustMm) {
+        ModifierFitOptions o;
+        o.regularisation = 1e-9;
+        o.robustMm = robustMm;
+        o.robustIterations = 10;
+        o.sweeps = 5000;
+        const ModifierFit f = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
+        double sum = 0.0;
+        for (std::size_t k = 0; k < truth.size(); ++k) sum += std::abs(f.weights[k] - truth[k]);
+        return sum;
+    };
+    const double plain = error(0.0), robust = error(1.0);
+    EXPECT_GT(plain, 0.05);
+    EXPECT_LT(robust, 0.25 * plain);
 }
 
 }  // namespace

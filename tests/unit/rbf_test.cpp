@@ -32,6 +32,18 @@ TEST(Rbf, PaperKernelTwoCentresKnownValues) {
     EXPECT_DOUBLE_EQ(warp.kernel(10.0), 0.5);
 }
 
+TEST(Rbf, PerCentreRidgeLetsThatCentreGiveWay) {
+    // Ridge 1 on the first centre only: [[2, 1/2], [1/2, 1]] u = (1, 0), so u = (4/7, -2/7); the first centre moves
+    // 4/7 - 1/7 = 3/7 of its displacement, the second still exactly 0.
+    const RbfWarp warp({{0, 0, 0}, {10, 0, 0}}, {{1.0}, {0.0}}, options(RbfKernel::InverseDistance), {1.0, 0.0});
+    EXPECT_NEAR(warp.weights()[0][0], 4.0 / 7.0, 1e-12);
+    EXPECT_NEAR(warp.weights()[1][0], -2.0 / 7.0, 1e-12);
+    EXPECT_NEAR(warp.evaluate({0, 0, 0})[0], 3.0 / 7.0, 1e-12);
+    EXPECT_NEAR(warp.evaluate({10, 0, 0})[0], 0.0, 1e-12);
+    EXPECT_THROW(RbfWarp({{0, 0, 0}, {10, 0, 0}}, {{1.0}, {0.0}}, options(RbfKernel::InverseDistance), {1.0}),
+                 std::invalid_argument);
+}
+
 TEST(Rbf, GaussianKernelKnownValues) {
     RbfOptions o = options(RbfKernel::Gaussian);
     o.gaussianSigma = 2.0;

@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <set>
@@ -99,6 +100,8 @@ struct ViewTargets {
     std::vector<std::vector<double>> displacements;
     std::vector<std::uint32_t> vertices;
     std::vector<std::pair<std::string, glm::dvec2>> targets;
+    std::vector<glm::dvec2> outlineNormals;  // the unit normal of an outline target in the view's plane, else 0
+    std::vector<glm::dvec2> measured;        // where the photo put the point, before the projection on the normal
     std::set<std::uint32_t> used;
 
     // A point measured on a smooth stretch of outline says only how far out the outline is there, not where along
@@ -109,13 +112,16 @@ struct ViewTargets {
         if (!used.insert(v).second) return;
         const glm::dvec3 c = mesh.positions[v];
         const glm::dvec2 now = projectToView(c, view);
+        glm::dvec2 outlineNormal(0.0);
+        measured.push_back(target);
         if (normals) {
             const glm::dvec2 n = projectToView((*normals)[v], view);
             if (glm::length(n) > 1e-6) {
-                const glm::dvec2 u = glm::normalize(n);
-                target = now + u * glm::dot(u, target - now);
+                outlineNormal = glm::normalize(n);
+                target = now + outlineNormal * glm::dot(outlineNormal, target - now);
             }
         }
+        outlineNormals.push_back(outlineNormal);
         centres.push_back(c);
         displacements.push_back({target.x - now.x, target.y - now.y});
         vertices.push_back(v);
@@ -238,13 +244,20 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         const double depthPhoto = (side("glabella").x - side("back_of_head").x) * sideMmPerPx;
         const double depthBase = pos("glabella").z - pos("back_of_head").z;
         // Measured once, on the base head: in later rounds the modifiers change the extents, and scaling them back
-        // to the measured ones would undo what the modifiers found.
-        if (round == 0) fit.axisScale = glm::dvec3(widthPhoto / widthBase, heightPhoto / heightBase, depthPhoto / depthBase);
+        // to the measured ones would undo what the modifiers found. With a modifier basis the head is scaled
+        // uniformly by the face's width (dlib's jaw line: no hair in it) and the modifiers (the head's own
+        // scale-vert/-depth among them) take its proportions from the landmarks; the height and depth include the
+        // hair, and scaling by them stretched the face (on the synthetic population the fit from ground-truth
+        // landmarks came 0.1-0.4 mm nearer the true face without it). They still say whether it is a head at all.
+        if (round == 0) {
+            fit.measuredExtents = glm::dvec3(widthPhoto / widthBase, heightPhoto / heightBase, depthPhoto / depthBase);
+            fit.axisScale = base.modifiers ? glm::dvec3(fit.measuredExtents.x) : fit.measuredExtents;
+        }
         for (int c = 0; c < 3; ++c)
-            if (!(fit.axisScale[c] > 0.6 && fit.axisScale[c] < 1.6))
+            if (!(fit.measuredExtents[c] > 0.6 && fit.measuredExtents[c] < 1.6))
                 throw BoothError(ErrorKind::Mismatch, "",
                                  std::string("the measured head ") + (c == 0 ? "width" : c == 1 ? "height" : "depth") +
-                                     " is " + std::to_string(fit.axisScale[c]) + " times the base head's: not a plausible head");
+                                     " is " + std::to_string(fit.measuredExtents[c]) + " times the base head's: not a plausible head");
         if (tieError > 0.06 * heightPhoto)
             throw BoothError(ErrorKind::Mismatch, "",
                              "the heights of the nose, lips and top of head disagree between the photos by " +
@@ -322,8 +335,13 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
             for (std::size_t k = 0; k < view->vertices.size(); ++k) {
                 // The outline rays meet hair as often as skin: they shape the head less than the landmarks do.
                 const bool contour = view->targets[k].first.find("_contour_") != std::string::npos;
-                targets.push_back({view->vertices[k], view->view, view->targets[k].second,
-                                   glm::dvec2(contour ? options.contourWeight : 1.0)});
+                const bool onOutline = glm::dot(view->outlineNormals[k], view->outlineNormals[k]) > 0.0;
+                const double weight = contour ? options.contourWeight : 1.0;
+                // A ray's crossing says nothing about where along the outline the vertex lies; a profile landmark
+                // says a little (outlineTangentWeight).
+                const double along = !onOutline ? weight : contour ? 0.0 : options.outlineTangentWeight * weight;
+                targets.push_back({view->vertices[k], view->view, view->measured[k], glm::dvec2(weight, along),
+                                   view->outlineNormals[k]});
             }
         const ModifierFit m = fitModifiers(*base.modifiers, base.mesh.positions, fit.axisScale, base.earHoleCentre, targets,
                                            options.modifiers);
@@ -337,8 +355,15 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     const Mesh& s = fit.scaledBase;
 
     // --- Step 5: the RBF warps, (x, y) from the front and (z, y) from the side, merged.
-    const RbfWarp frontWarp(frontT.centres, frontT.displacements, options.rbf);
-    const RbfWarp sideWarp(sideT.centres, sideT.displacements, options.rbf);
+    // The landmarks give way by landmarkRidge; the outline rays are interpolated exactly.
+    const auto ridgeOf = [&](const ViewTargets& view) {
+        std::vector<double> ridge;
+        for (const auto& [name, target] : view.targets)
+            ridge.push_back(name.find("_contour_") != std::string::npos ? 0.0 : options.landmarkRidge);
+        return ridge;
+    };
+    const RbfWarp frontWarp(frontT.centres, frontT.displacements, options.rbf, ridgeOf(frontT));
+    const RbfWarp sideWarp(sideT.centres, sideT.displacements, options.rbf, ridgeOf(sideT));
     const auto normals = s.vertexNormals();
     fit.mesh = s;
     for (std::size_t i = 0; i < s.positions.size(); ++i) {
@@ -352,21 +377,31 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         fit.mesh.positions[i] = p + glm::dvec3(df[0], wFront * df[1] + (1.0 - wFront) * ds[1], ds[0]);
     }
     // The blend leaves feature vertices a little off their measured y. A last warp over all feature vertices (with
-    // the same kernel) moves each onto its y exactly; a vertex measured in both photos takes the mean of the two.
-    std::map<std::uint32_t, std::pair<double, int>> yTargets;
-    for (const ViewTargets* view : {&frontT, &sideT})
+    // the same kernel and ridge) moves each onto its y; a vertex measured in both photos takes the mean of the two.
+    struct YTarget {
+        double sum = 0.0;
+        int count = 0;
+        double ridge = 0.0;
+    };
+    std::map<std::uint32_t, YTarget> yTargets;
+    for (const ViewTargets* view : {&frontT, &sideT}) {
+        const std::vector<double> ridge = ridgeOf(*view);
         for (std::size_t k = 0; k < view->vertices.size(); ++k) {
             auto& t = yTargets[view->vertices[k]];
-            t.first += view->targets[k].second.y;
-            ++t.second;
+            t.sum += view->targets[k].second.y;
+            ++t.count;
+            t.ridge = std::max(t.ridge, ridge[k]);
         }
+    }
     std::vector<glm::dvec3> yCentres;
     std::vector<std::vector<double>> yDisp;
+    std::vector<double> yRidge;
     for (const auto& [v, t] : yTargets) {
         yCentres.push_back(fit.mesh.positions[v]);
-        yDisp.push_back({t.first / t.second - fit.mesh.positions[v].y});
+        yDisp.push_back({t.sum / t.count - fit.mesh.positions[v].y});
+        yRidge.push_back(t.ridge);
     }
-    const RbfWarp yWarp(yCentres, yDisp, options.rbf);
+    const RbfWarp yWarp(yCentres, yDisp, options.rbf, yRidge);
     for (auto& p : fit.mesh.positions) p.y += yWarp.evaluate(p)[0];
     // Where features lie close together with conflicting pulls (eyelids, lips) the warp can turn the surface over;
     // those places take their neighbours' displacement instead.

@@ -35,6 +35,14 @@ struct HeadFitOptions {
     int modifierRounds = 1;
     // Weight of an outline point against a landmark's in the modifier fit.
     double contourWeight = 0.3;
+    // A profile landmark on a smooth stretch of outline (chin, brow, lips, ...) is measured along the outline's
+    // normal with full weight and along the outline with this weight in the modifier fit: the detector's idea of
+    // where along the curve the point lies is a convention, but not worthless (the ground truth's too).
+    double outlineTangentWeight = 0.3;
+    // Ridge of the warp for the landmarks (added to rbf.regularisation on their diagonal; the outline rays keep the
+    // exact interpolation): a detected landmark is a few pixels off, and the warp that passes through each one
+    // exactly carries that noise into the face the modifiers had already shaped.
+    double landmarkRidge = 3.0;
 };
 
 HeadFitOptions defaultHeadFitOptions();
@@ -63,8 +71,10 @@ struct PhotoFrame {
 
 struct HeadFit {
     Mesh mesh;                   // the fitted head (base head topology)
-    Mesh scaledBase;             // the base head after steps 1-2 (modifiers, per-axis scaling), before the warp
-    glm::dvec3 axisScale{1.0};   // sx, sy, sz of step 2
+    Mesh scaledBase;             // the base head after steps 1-2 (modifiers, scaling), before the warp
+    glm::dvec3 axisScale{1.0};   // sx, sy, sz of step 2, as applied
+    // The photos' head width, height and depth over the base head's (height and depth include the hair).
+    glm::dvec3 measuredExtents{1.0};
     PhotoFrame front, side;
     std::vector<FeatureResidual> residuals;
     // Contour rays for the overlays: from the view's centre to the measured outline point (pixels).

@@ -9,6 +9,19 @@
 #include <map>
 
 namespace avatarbooth {
+namespace {
+
+// A target's two rows as directions in the view's plane, each scaled by the square root of its weight: the axes
+// (a, b) for a point, the outline's normal and nothing for an outline point.
+std::pair<glm::dvec2, glm::dvec2> rowDirections(const ModifierTarget& t) {
+    if (glm::dot(t.normal, t.normal) > 0.0) {
+        const glm::dvec2 n = glm::normalize(t.normal);
+        return {std::sqrt(t.weight.x) * n, std::sqrt(t.weight.y) * glm::dvec2(-n.y, n.x)};
+    }
+    return {glm::dvec2(std::sqrt(t.weight.x), 0.0), glm::dvec2(0.0, std::sqrt(t.weight.y))};
+}
+
+}  // namespace
 
 ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec3>& basePositions, const glm::dvec3& scale,
                          const glm::dvec3& centre, const std::vector<ModifierTarget>& targets,
@@ -24,56 +37,81 @@ ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec
         rowsOf.emplace(t.vertex, i);
         const glm::dvec3 p = centre + scale * (basePositions.at(t.vertex) - centre);
         const glm::dvec2 now = projectToView(p, t.view);
-        const glm::dvec2 sw = glm::sqrt(t.weight);  // rows scaled by the square roots of the weights
-        r0[2 * i] = sw.x * (t.target.x - now.x);
-        r0[2 * i + 1] = sw.y * (t.target.y - now.y);
-        A[(2 * i) * n + K + (t.view == View::Front ? 0 : 2)] = sw.x;  // t_x moves front a, t_z side a
-        A[(2 * i + 1) * n + K + 1] = sw.y;                              // t_y moves b in both
+        // Each row measures the error along one direction of the view's plane, scaled by the square root of its
+        // weight: the plane's axes, or the outline's normal alone.
+        const auto [e0, e1] = rowDirections(t);
+        const glm::dvec2 d = t.target - now;
+        r0[2 * i] = glm::dot(e0, d);
+        r0[2 * i + 1] = glm::dot(e1, d);
+        for (const auto& [row, e] : {std::pair{2 * i, e0}, std::pair{2 * i + 1, e1}}) {
+            A[row * n + K + (t.view == View::Front ? 0 : 2)] = e.x;  // t_x moves front a, t_z side a
+            A[row * n + K + 1] = e.y;                                 // t_y moves b in both
+        }
     }
     for (std::size_t k = 0; k < K; ++k) {
         const Modifier& m = basis.modifiers[k];
         for (std::size_t j = 0; j < m.vertices.size(); ++j) {
             const auto range = rowsOf.equal_range(m.vertices[j]);
             for (auto it = range.first; it != range.second; ++it) {
-                const ModifierTarget& t = targets[it->second];
-                const glm::dvec2 d = glm::sqrt(t.weight) * projectToView(scale * glm::dvec3(m.offsets[j]), t.view);
-                A[(2 * it->second) * n + k] += d.x;
-                A[(2 * it->second + 1) * n + k] += d.y;
+                const auto [e0, e1] = rowDirections(targets[it->second]);
+                const glm::dvec2 d = projectToView(scale * glm::dvec3(m.offsets[j]), targets[it->second].view);
+                A[(2 * it->second) * n + k] += glm::dot(e0, d);
+                A[(2 * it->second + 1) * n + k] += glm::dot(e1, d);
             }
         }
     }
-    // Normal equations N w = g.
-    std::vector<double> N(n * n, 0.0), g(n, 0.0);
-    for (std::size_t r = 0; r < rows; ++r) {
-        const double* a = &A[r * n];
-        for (std::size_t i = 0; i < n; ++i) {
-            if (a[i] == 0.0) continue;
-            g[i] += a[i] * r0[r];
-            for (std::size_t j = i; j < n; ++j) N[i * n + j] += a[i] * a[j];
-        }
-    }
-    for (std::size_t i = 0; i < n; ++i)
-        for (std::size_t j = 0; j < i; ++j) N[i * n + j] = N[j * n + i];
-    for (std::size_t k = 0; k < K; ++k) N[k * n + k] += options.regularisation;
-    for (std::size_t i = K; i < n; ++i) N[i * n + i] += 1e-9;
     std::vector<bool> fixed(n, false);
     for (std::size_t k = 0; k < K; ++k)
         fixed[k] = std::find(options.fixedGroups.begin(), options.fixedGroups.end(), basis.modifiers[k].group) !=
                    options.fixedGroups.end();
-    std::vector<double> w(n, 0.0);
-    for (int sweep = 0; sweep < options.sweeps; ++sweep) {
-        double change = 0.0;
-        for (std::size_t i = 0; i < n; ++i) {
-            if (fixed[i] || N[i * n + i] <= 0.0) continue;
-            double s = g[i];
-            const double* row = &N[i * n];
-            for (std::size_t j = 0; j < n; ++j) s -= row[j] * w[j];
-            double next = w[i] + s / row[i];
-            if (i < K) next = std::clamp(next, 0.0, 1.0);
-            change = std::max(change, std::abs(next - w[i]));
-            w[i] = next;
+    // Iteratively reweighted least squares (Huber): after each solve a target whose error exceeds robustMm counts
+    // with weight robustMm / error, so that one misplaced point (a chin found on the lip) cannot bend the head.
+    std::vector<double> w(n, 0.0), rowWeight(rows, 1.0);
+    const int solves = options.robustMm > 0.0 ? 1 + options.robustIterations : 1;
+    for (int solve = 0; solve < solves; ++solve) {
+        if (solve > 0)
+            for (std::size_t i = 0; i < targets.size(); ++i) {
+                double e2 = 0.0;
+                for (const std::size_t r : {2 * i, 2 * i + 1}) {
+                    double pred = 0.0;
+                    for (std::size_t j = 0; j < n; ++j) pred += A[r * n + j] * w[j];
+                    e2 += (r0[r] - pred) * (r0[r] - pred);
+                }
+                const double e = std::sqrt(e2);
+                rowWeight[2 * i] = rowWeight[2 * i + 1] = e > options.robustMm ? options.robustMm / e : 1.0;
+            }
+        // Normal equations N w = g.
+        std::vector<double> N(n * n, 0.0), g(n, 0.0);
+        for (std::size_t r = 0; r < rows; ++r) {
+            const double* a = &A[r * n];
+            const double rw = rowWeight[r];
+            for (std::size_t i = 0; i < n; ++i) {
+                if (a[i] == 0.0) continue;
+                g[i] += rw * a[i] * r0[r];
+                for (std::size_t j = i; j < n; ++j) N[i * n + j] += rw * a[i] * a[j];
+            }
         }
-        if (change < 1e-7) break;
+        for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t j = 0; j < i; ++j) N[i * n + j] = N[j * n + i];
+        for (std::size_t k = 0; k < K; ++k) {
+            const auto group = options.groupRegularisation.find(basis.modifiers[k].group);
+            N[k * n + k] += group != options.groupRegularisation.end() ? group->second : options.regularisation;
+        }
+        for (std::size_t i = K; i < n; ++i) N[i * n + i] += 1e-9;
+        for (int sweep = 0; sweep < options.sweeps; ++sweep) {
+            double change = 0.0;
+            for (std::size_t i = 0; i < n; ++i) {
+                if (fixed[i] || N[i * n + i] <= 0.0) continue;
+                double s = g[i];
+                const double* row = &N[i * n];
+                for (std::size_t j = 0; j < n; ++j) s -= row[j] * w[j];
+                double next = w[i] + s / row[i];
+                if (i < K) next = std::clamp(next, 0.0, 1.0);
+                change = std::max(change, std::abs(next - w[i]));
+                w[i] = next;
+            }
+            if (change < 1e-7) break;
+        }
     }
     ModifierFit fit;
     fit.weights.assign(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(K));

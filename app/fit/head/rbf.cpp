@@ -38,11 +38,12 @@ double RbfWarp::kernel(double distanceMm) const {
 }
 
 RbfWarp::RbfWarp(std::vector<glm::dvec3> centres, const std::vector<std::vector<double>>& displacements,
-                 const RbfOptions& options)
+                 const RbfOptions& options, const std::vector<double>& ridge)
     : centres_(std::move(centres)), options_(options) {
     const std::size_t n = centres_.size();
     if (n == 0) throw std::invalid_argument("RBF warp needs at least one centre");
     if (displacements.size() != n) throw std::invalid_argument("RBF warp: one displacement per centre expected");
+    if (!ridge.empty() && ridge.size() != n) throw std::invalid_argument("RBF warp: one ridge value per centre expected");
     if (!(options_.unitMm > 0.0)) throw std::invalid_argument("RBF warp: unit must be positive");
     dims_ = displacements.front().size();
     const bool affine = options_.kernel == RbfKernel::ThinPlate;
@@ -56,7 +57,7 @@ RbfWarp::RbfWarp(std::vector<glm::dvec3> centres, const std::vector<std::vector<
         if (displacements[k].size() != dims_) throw std::invalid_argument("RBF warp: ragged displacements");
         for (std::size_t j = 0; j < n; ++j)
             a.at<double>(static_cast<int>(k), static_cast<int>(j)) = kernel(glm::distance(centres_[k], centres_[j]));
-        a.at<double>(static_cast<int>(k), static_cast<int>(k)) += options_.regularisation;
+        a.at<double>(static_cast<int>(k), static_cast<int>(k)) += options_.regularisation + (ridge.empty() ? 0.0 : ridge[k]);
         for (std::size_t d = 0; d < dims_; ++d) b.at<double>(static_cast<int>(k), static_cast<int>(d)) = displacements[k][d];
         if (affine) {
             const glm::dvec3 q = centres_[k] / options_.unitMm;

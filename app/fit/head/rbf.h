@@ -36,9 +36,11 @@ struct RbfOptions {
 // Solving is exact (LU with partial pivoting on the n x n, or (n+4) x (n+4), system), not iterative.
 class RbfWarp {
 public:
-    // centres: the feature vertices on the (scaled) base head; displacements: one row of D values per centre.
+    // centres: the feature vertices on the (scaled) base head; displacements: one row of D values per centre;
+    // ridge: optional, one value per centre added to the options' regularisation on that centre's diagonal (a
+    // noisy measurement gives way, an exact one does not).
     RbfWarp(std::vector<glm::dvec3> centres, const std::vector<std::vector<double>>& displacements,
-            const RbfOptions& options);
+            const RbfOptions& options, const std::vector<double>& ridge = {});
 
     // The displacement at p: v(p) = sum_j u_j f(|p - c_j|) (+ affine part for the thin-plate kernel).
     std::vector<double> evaluate(const glm::dvec3& p) const;
