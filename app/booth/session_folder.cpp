@@ -1,5 +1,7 @@
-// Writing the session folder: avatar.glb, the photos, overlays, previews, landmarks.json, the character, fit.json.
+// Writing the session folder: avatar.glb and avatar.usdz, the photos, overlays, previews, landmarks.json, the character, fit.json.
 #include "booth/session_folder.h"
+
+#include "booth/usdz.h"
 
 #include "common/atomic_output.h"
 #include "common/file_bytes.h"
@@ -108,6 +110,8 @@ std::vector<fs::path> writeSessionFolder(const FitOutcome& o, const SessionFolde
     };
     const auto t0 = Clock::now();
     put("avatar.glb", encodeGlb(o.fit.mesh, o.texture.texture, "avatar"));
+    // The same avatar for iOS's AR Quick Look (the visitor's page offers both: booth/usdz.h).
+    put("avatar.usdz", encodeUsdz(o.fit.mesh, o.texture.texture));
     // The photos themselves, as taken (personal data: the files are readable by the booth's user only).
     photo("front", contents.photoFiles.front, o.front);
     photo("side", contents.photoFiles.side, o.side);

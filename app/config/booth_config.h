@@ -11,6 +11,7 @@
 #include "reveal/animation/avatar_motion.h"
 #include "booth/guidance.h"
 #include "booth/session_store.h"
+#include "booth/share_link.h"
 #include "booth/visitor_flow.h"
 #include "drivers/camera/camera_settings.h"
 #include "drivers/display/display_settings.h"
@@ -58,6 +59,7 @@ struct BoothConfig {
     CharacterConfig character;      // [character]
     RevealSettings reveal;          // [reveal]
     StageSettings stage;            // [stage]
+    ShareSettings share;            // [share]
 };
 
 // Every mistake in a configuration file, in line order, each a BoothError(BadConfig) "FILE:LINE: key: what is
