@@ -17,7 +17,9 @@
 #include "drivers/gpio/button_backends.h"
 #include "drivers/gpio/gpiod_lines.h"
 #include "fit/face/landmarks68.h"
+#include "batch/batch_report.h"
 #include "booth/screens/strings.h"
+#include "booth/share_link.h"
 
 #include <nlohmann/json.hpp>
 
@@ -44,7 +46,7 @@ constexpr const char* kInstalledConfig = "/etc/avatarbooth/booth.toml";
 enum class Status { Ok, Warn, Fail };
 
 struct CheckLine {
-    std::string what;  // "config", "camera", "gpio", "display", "landmarks", "strings", "sessions"
+    std::string what;  // "config", "camera", "gpio", "display", "landmarks", "strings", "sessions", "share"
     Status status = Status::Ok;
     std::string message;
     ErrorKind kind = ErrorKind::Internal;  // for the exit code of a FAIL
@@ -278,6 +280,32 @@ void checkSessions(const fs::path& dir, Report& report) {
     else report.ok("sessions", where + ": writable, " + freeText);
 }
 
+// The visitors' page service ([share], `avatarbooth share`): off (nothing listens), or where it listens, the URL the
+// QR codes carry, and whether what it needs is there (TLS files readable, the 3-D viewer installed).
+void checkShare(const ShareSettings& share, const SessionStoreSettings& sessions, Report& report) {
+    if (!share.enabled) {
+        report.ok("share", "off ([share] enabled = false): no QR code, nothing listens");
+        return;
+    }
+    std::string what = "on: avatarbooth-share listens on " + share.listen + (share.tlsCertificate.empty() ? " (http)" : " (https)") +
+                       ", QR codes link " + shareBaseUrl(share) + "/s/<token>";
+    const auto lifetime = sessions.sessionRetention.count() > 0 ? std::min(share.pageLifetime, sessions.sessionRetention)
+                                                                : share.pageLifetime;
+    what += ", pages live " + std::to_string(std::chrono::duration_cast<std::chrono::hours>(lifetime).count()) + " h";
+    what += std::string(", downloads ") + (share.offerDownloads ? "on" : "off") + ", photos " + (share.offerPhotos ? "on" : "off");
+    for (const fs::path& f : {share.tlsCertificate, share.tlsKey}) {
+        if (!f.empty() && ::access(f.c_str(), R_OK) != 0) {
+            report.fail("share", what + "; " + f.string() + " is not readable", ErrorKind::BadConfig);
+            return;
+        }
+    }
+    if (findModelViewer().empty()) {
+        report.warn("share", what + "; model-viewer is not installed: pages offer downloads without the 3-D view");
+        return;
+    }
+    report.ok("share", what);
+}
+
 }  // namespace
 
 void registerCheckCommand(CLI::App& app) {
@@ -300,6 +328,7 @@ void registerCheckCommand(CLI::App& app) {
         checkBaseHead(config.fit, report);
         checkStrings(config.screen.stringsFile, report);
         checkSessions(config.sessions.directory, report);
+        checkShare(config.share, config.sessions, report);
 
         std::optional<ErrorKind> firstFailure;
         int fails = 0, warns = 0;

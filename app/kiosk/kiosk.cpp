@@ -4,6 +4,7 @@
 
 #include "booth/session_lifecycle.h"
 #include "booth/session_store.h"
+#include "booth/share_link.h"
 #include "booth/visitor_flow.h"
 #include "booth/screens/screens.h"
 #include "common/error.h"
@@ -413,6 +414,10 @@ void Kiosk::runSession(const std::vector<session::Command>& commands, FlowTime n
                     try {
                         done.code = store_.keep(c.folder, std::chrono::system_clock::now());
                         if (const auto kept = store_.find(done.code)) done.keptFolder = *kept;
+                        // The visitor's page, for the QR code on the thanks screen (only when sharing is on).
+                        if (config_.share.enabled)
+                            if (const auto token = readShareToken(done.keptFolder))
+                                done.shareUrl = sharePageUrl(config_.share, *token);
                     } catch (const BoothError& e) {
                         done.error = e.what();
                     }

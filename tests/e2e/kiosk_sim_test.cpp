@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cstdlib>
 #include <fstream>
 #include <regex>
 
@@ -36,8 +37,11 @@ double headPixelsInMiddle(const cv::Mat& bgr) {
 TEST(KioskSim, OneScriptedSessionEndToEnd) {
     const fs::path dir = scratchDir("kiosk_sim");
     const fs::path config = dir / "booth.toml";
+    // With the visitor's page on (issue 23): the thanks screen shows its QR code (nothing listens: that is
+    // `avatarbooth share`'s job, tests/e2e/share_*_test.cpp).
     std::ofstream(config) << "[camera]\nbackend = \"sim\"\n[buttons]\nbackend = \"sim\"\n[display]\nbackend = \"headless\"\n"
-                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n";
+                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n"
+                          << "[share]\nenabled = true\nlisten = \"127.0.0.1:8099\"\n";
     const CommandResult r = runAvatarbooth("run --config " + config.string() + " --sessions 1 --screenshots " + (dir / "screens").string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
 
@@ -50,6 +54,20 @@ TEST(KioskSim, OneScriptedSessionEndToEnd) {
     EXPECT_EQ(fs::status(session).permissions() & (fs::perms::group_all | fs::perms::others_all), fs::perms::none);
     EXPECT_FALSE(fs::exists(dir / "sessions" / ".pending") && !fs::is_empty(dir / "sessions" / ".pending"))
         << "a pending fit was left behind";
+    // The thanks screenshot's QR code (read by zbarimg, Debian zbar-tools, as a phone would) is the kept session's
+    // page: its token, from its session.json.
+    if (std::system("command -v zbarimg >/dev/null 2>&1") == 0) {
+        std::string qr;
+        FILE* pipe = popen(("zbarimg --raw -q " + (dir / "screens" / "09_thanks.png").string() + " 2>/dev/null").c_str(), "r");
+        std::array<char, 512> buf{};
+        while (fgets(buf.data(), buf.size(), pipe)) qr += buf.data();
+        pclose(pipe);
+        std::ifstream in(session / "session.json");
+        const std::string info((std::istreambuf_iterator<char>(in)), {});
+        std::smatch token;
+        ASSERT_TRUE(std::regex_search(info, token, std::regex("\"share_token\": \"([0-9a-f]{32})\""))) << info;
+        EXPECT_EQ(qr, "http://127.0.0.1:8099/s/" + token[1].str() + "\n");
+    }
 
     // A screenshot of every screen of the session, in the order shown.
     std::vector<std::string> shown;
