@@ -21,6 +21,8 @@ packages=(
   libfreetype-dev fonts-dejavu-core fonts-vlgothic
   # image files (app/common/image_codec): libjpeg-turbo, libpng, libexif (orientation), stb_image (BMP)
   libjpeg-dev libpng-dev libexif-dev libstb-dev zlib1g-dev
+  # the visitor's page (issue 23): the thanks screen's QR code, and `avatarbooth share`'s HTTP(S) server
+  libqrencode-dev libcpp-httplib-dev
   # (the build's configuration looks for the test and benchmark libraries)
   libgtest-dev libgmock-dev libbenchmark-dev
   systemd device-tree-compiler
@@ -37,6 +39,8 @@ test_packages=(
   clang-14 libclang-rt-14-dev
   # the e2e test of the development window runs it under a virtual X server
   xvfb
+  # the thanks screen's QR code is read back from its screenshot (zbarimg)
+  zbar-tools
   # the `kernel` tests (tests/kernel/): qemu boots Debian's kernel; busybox/cpio/kmod make its initramfs and
   # module tree (modules built with gcc-12/make); v4l-utils, udev, libcamera-ipa/-tools are used inside the guest
   qemu-system-x86 busybox-static cpio kmod xz-utils make gcc-12 libc6-dev v4l-utils udev libcamera-ipa libcamera-tools
