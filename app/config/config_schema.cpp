@@ -619,6 +619,8 @@ void addShareKeys(std::vector<ConfigKey>& k) {
             const bool scheme = url.rfind("http://", 0) == 0 || url.rfind("https://", 0) == 0;
             if (!url.empty() && (!scheme || url.find_first_of(" \t\"<>?#") != std::string::npos))
                 throw ConfigValueRejected{"\"" + url + "\" is not an http:// or https:// URL without query"};
+            // The QR code gets denser with every character: a short URL scans from further away.
+            if (url.size() > 100) throw ConfigValueRejected{"longer than 100 characters (the QR code would be too dense)"};
             store(c, i, v);
         };
         k.push_back(std::move(base));

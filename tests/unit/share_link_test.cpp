@@ -109,6 +109,8 @@ TEST(ShareConfig, MistakesNameFileLineAndKey) {
               "booth.toml:3: share.listen: \"10.42.0.1\" is not ADDRESS:PORT (port 1-65535)");
     EXPECT_EQ(errorOf("[share]\nbase_url = \"booth.local\"\n"),
               "booth.toml:2: share.base_url: \"booth.local\" is not an http:// or https:// URL without query");
+    EXPECT_EQ(errorOf("[share]\nbase_url = \"http://" + std::string(100, 'b') + "\"\n"),
+              "booth.toml:2: share.base_url: longer than 100 characters (the QR code would be too dense)");
     EXPECT_EQ(errorOf("[share]\nworkers = 0\n"), "booth.toml:2: share.workers: must be between 1 and 64, got 0");
     EXPECT_EQ(errorOf("[share]\ntls_certificate = \"/etc/ssl/booth.pem\"\n"),
               "booth.toml:2: share.tls_certificate: give both tls_certificate and tls_key, or neither");

@@ -651,13 +651,19 @@ void ScreenRenderer::thanks(const ScreenModel& m) {
         drawText(str("thanks.instructions"), info, static_cast<int>(40 * u), kSoftWhite);
         return;
     }
-    // The QR code: whole pixels per module, as large as L.qr allows, drawn once per session.
+    // The QR code: whole pixels per module, as large as L.qr allows, drawn once per session. (A URL no QR code
+    // holds cannot come from a checked configuration; the screen would then show the code alone.)
     if (qrUrl_ != m.shareUrl) {
-        const cv::Mat modules = encodeQrModules(m.shareUrl);
-        const int perModule = std::max(1, L.qr.width / (modules.cols + 2 * kQrQuietModules));
-        qrImage_ = drawQrCode(modules, perModule);
+        try {
+            const cv::Mat modules = encodeQrModules(m.shareUrl);
+            const int perModule = std::max(1, L.qr.width / (modules.cols + 2 * kQrQuietModules));
+            qrImage_ = drawQrCode(modules, perModule);
+        } catch (const BoothError&) {
+            qrImage_.release();
+        }
         qrUrl_ = m.shareUrl;
     }
+    if (qrImage_.empty()) return;
     const cv::Rect at(L.qr.x + (L.qr.width - qrImage_.cols) / 2, L.qr.y + (L.qr.height - qrImage_.rows) / 2,
                       qrImage_.cols, qrImage_.rows);
     qrImage_.copyTo(canvas_(at & cv::Rect(0, 0, canvas_.cols, canvas_.rows)));
