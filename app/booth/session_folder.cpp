@@ -125,6 +125,12 @@ std::vector<fs::path> writeSessionFolder(const FitOutcome& o, const SessionFolde
     put("preview_front.png", encodeImage(previews.front, ".png"));
     put("preview_side.png", encodeImage(previews.side, ".png"));
     put("preview_three_quarter.png", encodeImage(previews.threeQuarter, ".png"));
+    // The character's picture too, for the printed card (print/card.h), which is made from the session alone.
+    if (contents.character) {
+        renderer.upload(contents.character->head.mesh, contents.character->head.texture);
+        put("preview_character.png", encodeImage(renderThreeQuarterPreview(renderer, contents.character->head.mesh,
+                                                                           contents.previewSize), ".png"));
+    }
     const double previewSeconds = secondsSince(t1);
 
     put("landmarks.json", landmarksJson(o).dump(2) + "\n");

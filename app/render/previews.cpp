@@ -43,9 +43,13 @@ RenderCamera framedCamera(const Mesh& mesh, glm::dvec3 direction, glm::dvec3 up,
     return camera;
 }
 
-}  // namespace
+glm::dvec3 threeQuarterDirection() {
+    const double elevation = glm::radians(15.0);
+    return {-std::sin(glm::radians(45.0)) * std::cos(elevation), std::sin(elevation),
+            std::cos(glm::radians(45.0)) * std::cos(elevation)};
+}
 
-PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size) {
+void checkUploaded(const MeshRenderer& renderer, const Mesh& mesh, int size) {
     if (mesh.positions.empty() || mesh.triangles.empty())
         throw BoothError(ErrorKind::Internal, "", "previews: the mesh is empty");
     if (renderer.vertexCount() != mesh.positions.size() || renderer.triangleCount() != mesh.triangles.size())
@@ -56,16 +60,23 @@ PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size) {
                              std::to_string(renderer.vertexCount()) + " and " +
                              std::to_string(renderer.triangleCount()) + ")");
     if (size <= 0) throw BoothError(ErrorKind::Internal, "", "previews: size must be positive");
+}
 
+}  // namespace
+
+PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size) {
+    checkUploaded(renderer, mesh, size);
     const glm::dvec3 up(0.0, 1.0, 0.0);
-    const double elevation = glm::radians(15.0);
-    const glm::dvec3 threeQuarter(-std::sin(glm::radians(45.0)) * std::cos(elevation), std::sin(elevation),
-                                  std::cos(glm::radians(45.0)) * std::cos(elevation));
     PreviewSet set;
     set.front = renderer.render(framedCamera(mesh, {0.0, 0.0, 1.0}, up, size)).bgr;
     set.side = renderer.render(framedCamera(mesh, {-1.0, 0.0, 0.0}, up, size)).bgr;
-    set.threeQuarter = renderer.render(framedCamera(mesh, threeQuarter, up, size)).bgr;
+    set.threeQuarter = renderer.render(framedCamera(mesh, threeQuarterDirection(), up, size)).bgr;
     return set;
+}
+
+cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size) {
+    checkUploaded(renderer, mesh, size);
+    return renderer.render(framedCamera(mesh, threeQuarterDirection(), {0.0, 1.0, 0.0}, size)).bgr;
 }
 
 }  // namespace avatarbooth

@@ -20,4 +20,8 @@ struct PreviewSet {
 // the uploaded one.
 PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size = 512);
 
+// The three-quarter view alone (the same picture as PreviewSet::threeQuarter), for a second mesh such as the
+// character: the same checks.
+cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size = 512);
+
 }  // namespace avatarbooth
