@@ -72,7 +72,9 @@ set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
     "libdlib-data, opencv-data, fonts-dejavu-core, fonts-vlgothic, libegl-mesa0, libgl1-mesa-dri, systemd, udev")
-set(CPACK_DEBIAN_PACKAGE_SUGGESTS "device-tree-compiler, libcamera-tools, v4l-utils, gpiod")
+# cups: the printed card ([print]) goes to a CUPS queue, on this machine or another (libcups2 itself comes from
+# dpkg-shlibdeps).
+set(CPACK_DEBIAN_PACKAGE_SUGGESTS "device-tree-compiler, libcamera-tools, v4l-utils, gpiod, cups")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
     ${CMAKE_SOURCE_DIR}/packaging/postinst ${CMAKE_SOURCE_DIR}/packaging/postrm ${CMAKE_SOURCE_DIR}/packaging/conffiles)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)

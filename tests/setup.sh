@@ -23,6 +23,8 @@ packages=(
   libjpeg-dev libpng-dev libexif-dev libstb-dev zlib1g-dev
   # the visitor's page (issue 23): the thanks screen's QR code, and `avatarbooth share`'s HTTP(S) server
   libqrencode-dev libcpp-httplib-dev
+  # the printed card (issue 23): laid out with Cairo into a PDF, sent to CUPS with libcups
+  libcairo2-dev libcups2-dev
   # (the build's configuration looks for the test and benchmark libraries)
   libgtest-dev libgmock-dev libbenchmark-dev
   systemd device-tree-compiler
@@ -41,6 +43,9 @@ test_packages=(
   xvfb
   # the thanks screen's QR code is read back from its screenshot (zbarimg)
   zbar-tools
+  # the printed card's tests start their own CUPS scheduler with a PDF printer (cups-pdf, which pulls in cups-filters
+  # and Ghostscript) and read the PDF back (pdfinfo, pdftotext, pdftoppm)
+  cups-daemon cups-client printer-driver-cups-pdf poppler-utils
   # the `kernel` tests (tests/kernel/): qemu boots Debian's kernel; busybox/cpio/kmod make its initramfs and
   # module tree (modules built with gcc-12/make); v4l-utils, udev, libcamera-ipa/-tools are used inside the guest
   qemu-system-x86 busybox-static cpio kmod xz-utils make gcc-12 libc6-dev v4l-utils udev libcamera-ipa libcamera-tools

@@ -12,6 +12,7 @@
 #include "booth/guidance.h"
 #include "booth/session_store.h"
 #include "booth/share_link.h"
+#include "print/print_settings.h"
 #include "booth/visitor_flow.h"
 #include "drivers/camera/camera_settings.h"
 #include "drivers/display/display_settings.h"
@@ -60,6 +61,7 @@ struct BoothConfig {
     RevealSettings reveal;          // [reveal]
     StageSettings stage;            // [stage]
     ShareSettings share;            // [share]
+    PrintSettings print;            // [print]
 };
 
 // Every mistake in a configuration file, in line order, each a BoothError(BadConfig) "FILE:LINE: key: what is

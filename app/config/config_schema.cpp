@@ -335,6 +335,10 @@ std::vector<ConfigTable> makeTables() {
                                               "session_retention_days"};
                      return std::nullopt;
                  }});
+    t.push_back({.name = "print",
+                 .doc = "The printed card (off by default): Keep prints the visitor's three styles, the short code and "
+                        "the QR code of their page through a CUPS queue. The README's \"Take it home\" section sets up "
+                        "the printer."});
     return t;
 }
 
@@ -642,6 +646,37 @@ void addShareKeys(std::vector<ConfigKey>& k) {
                         "A connection silent for this long is closed (a slow or stalled client); whole seconds."));
 }
 
+void addPrintKeys(std::vector<ConfigKey>& k) {
+    // [print]
+    k.push_back(flag("print", "enabled", FIELD(print.enabled),
+                     "Keep prints a card of the session (its styles, code and QR code) on the CUPS queue."));
+    {
+        ConfigKey queue = text("print", "queue", FIELD(print.queue),
+                               "The CUPS queue (`lpstat -p` lists them); \"\" = the CUPS server's default queue.");
+        const auto store = queue.set;
+        queue.set = [store](BoothConfig& c, std::size_t i, const ConfigValue& v) {
+            const std::string& name = std::get<std::string>(v);
+            // CUPS refuses these in a queue's name (lpadmin(8)); a typo is caught here rather than at the first keep.
+            if (name.find_first_of(" \t/#\\\"'") != std::string::npos || name.size() > 127)
+                throw ConfigValueRejected{"\"" + name + "\" is not a CUPS queue name (no spaces, /, # or quotes)"};
+            store(c, i, v);
+        };
+        k.push_back(std::move(queue));
+    }
+    k.push_back(number("print", "width_mm", FIELD(print.widthMm), 50.0, 300.0,
+                       "The card's width in millimetres (100 x 148: the postcard photo printers take)."));
+    k.push_back(number("print", "height_mm", FIELD(print.heightMm), 50.0, 300.0, "The card's height in millimetres."));
+    k.push_back(integer("print", "dpi", FIELD(print.dpi), 72, 1200,
+                        "The resolution the card's pictures are placed at (text and the QR code are vectors)."));
+    k.push_back(text("print", "media", FIELD(print.media),
+                     "The printer's own name for the paper (\"Postcard\", \"w284h420\"; `lpoptions -p QUEUE -l` lists "
+                     "them); \"\" = the card's size as a custom size (\"Custom.100x148mm\")."));
+    k.push_back(flag("print", "front_photo", FIELD(print.frontPhoto),
+                     "The visitor's front photo on the card too (personal data on paper)."));
+    k.push_back(text("print", "title", FIELD(print.title), "The line across the card's top (\"\" = none)."));
+    k.push_back(integer("print", "copies", FIELD(print.copies), 1, 10, "Cards printed per kept session."));
+}
+
 std::vector<ConfigKey> makeKeys() {
     std::vector<ConfigKey> k;
     addFitKeys(k);
@@ -657,6 +692,7 @@ std::vector<ConfigKey> makeKeys() {
     addRevealKeys(k);
     addStageKeys(k);
     addShareKeys(k);
+    addPrintKeys(k);
     return k;
 }
 

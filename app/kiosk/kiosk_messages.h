@@ -57,8 +57,15 @@ struct StyleWorkEnded {
     std::function<void()> apply;
 };
 
+// The printer's news (PrintWorker): a card sent, a job's or the queue's new state; `problem` when the operator has
+// to act (out of paper, stopped, a job held or failed).
+struct PrintStatus {
+    std::string line;
+    bool problem = false;
+};
+
 using KioskMessage = std::variant<ModelLoaded, FitStepStarted, FitEnded, CharacterEnded, PreviewEnded, FolderEnded,
-                                  StyleWorkEnded>;
+                                  StyleWorkEnded, PrintStatus>;
 using KioskQueue = MessageQueue<KioskMessage>;
 
 }  // namespace avatarbooth

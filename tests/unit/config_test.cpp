@@ -237,6 +237,7 @@ TEST(Config, EveryKeyLandsInItsSetting) {
         // Text keys whose words are checked: values of their shape.
         if (key == "share.listen") candidates = {std::string("127.0.0.1:8080"), std::string("[::1]:443")};
         if (key == "share.base_url") candidates = {std::string("https://booth.example")};
+        if (key == "print.queue") candidates = {std::string("Canon_SELPHY_CP1500")};
         // A repeated table's element needs its required keys; fit's base head needs both files.
         std::string head = "[" + k.table + "]\n";
         if (k.table == "buttons.button" || k.table == "buttons.lamp")
