@@ -20,12 +20,14 @@
 #include "batch/batch_report.h"
 #include "booth/screens/strings.h"
 #include "booth/share_link.h"
+#include "print/cups_queue.h"
 
 #include <nlohmann/json.hpp>
 
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -306,6 +308,23 @@ void checkShare(const ShareSettings& share, const SessionStoreSettings& sessions
     report.ok("share", what);
 }
 
+// The printed card's queue ([print]): off, or what CUPS says of the queue (there? accepting? stopped, out of paper:
+// the printer-state-reasons). A queue that cannot take the card fails; the booth itself would go on without it.
+void checkPrint(const PrintSettings& print, Report& report) {
+    if (!print.enabled) {
+        report.ok("print", "off ([print] enabled = false): Keep prints nothing");
+        return;
+    }
+    const QueueState q = queryQueue(print.queue);
+    char card[96];
+    std::snprintf(card, sizeof card, "; card %gx%g mm at %d dpi, %d cop%s", print.widthMm, print.heightMm, print.dpi,
+                  print.copies, print.copies == 1 ? "y" : "ies");
+    const std::string what = "queue " + (q.queue.empty() ? std::string("(CUPS default)") : q.queue) + ": " + q.describe() + card;
+    if (!q.found() || !q.accepting || q.stopped) report.fail("print", what, ErrorKind::Device);
+    else if (q.problem()) report.warn("print", what);
+    else report.ok("print", what);
+}
+
 }  // namespace
 
 void registerCheckCommand(CLI::App& app) {
@@ -329,6 +348,7 @@ void registerCheckCommand(CLI::App& app) {
         checkStrings(config.screen.stringsFile, report);
         checkSessions(config.sessions.directory, report);
         checkShare(config.share, config.sessions, report);
+        checkPrint(config.print, report);
 
         std::optional<ErrorKind> firstFailure;
         int fails = 0, warns = 0;

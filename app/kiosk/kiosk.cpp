@@ -17,6 +17,7 @@
 #include "kiosk/kiosk_figures.h"
 #include "kiosk/kiosk_inputs.h"
 #include "kiosk/preview_worker.h"
+#include "kiosk/print_worker.h"
 #include "kiosk/screenshots.h"
 #include "kiosk/session_writer.h"
 #include "kiosk/style_worker.h"
@@ -137,6 +138,7 @@ private:
     HeadlessEglContext offscreen_;
     RevealStyles styles_;
     StyleWorker styleWorker_;  // after the styles: its work posts to them, it ends first
+    std::optional<PrintWorker> printer_;  // [print] on: each kept session's card
     std::optional<WatchdogPinger> watchdog_;  // from READY on
 
     // The visitor.
@@ -153,6 +155,12 @@ private:
     Hint lastHint_ = Hint::None;
     RetentionReport lastRetention_, lastFreed_;  // the last retention run, and the operator's last "free disk"
     int leftoversRemoved_ = 0;                   // by the last RemoveLeftovers
+    // The printer: its last news for the operator menu, and a kept session whose card waits for its toon strip
+    // (the card shows the toon: printed once the strip is written, or without it when the toon never comes).
+    std::string printerNews_;
+    bool printerProblem_ = false;
+    std::optional<PrintCard> cardAfterExtras_;
+    void printCard(PrintCard card);
     Screenshots screenshots_;
     KioskFigures figures_;
     bool ready_ = false;
@@ -186,6 +194,11 @@ Kiosk::Kiosk(const BoothConfig& config, const KioskOptions& options, SteadyClock
     note("buttons: " + board_.description);
     note("sessions: " + config.sessions.directory.string());
     report_.sessionsDirectory = config.sessions.directory;
+    if (config.print.enabled) {
+        printer_.emplace(config.print, queue_);
+        printerNews_ = "on, queue " + (config.print.queue.empty() ? std::string("(CUPS default)") : config.print.queue);
+        note("print: " + printerNews_);
+    }
     startupStep("devices, workers and styles made");
     commands_ = flow_.initialCommands();
 }
@@ -328,6 +341,12 @@ void Kiosk::handle(const KioskMessage& message, FlowTime now) {
                 figures_.analysed(flow_.screen().id);
             } else if constexpr (std::is_same_v<T, StyleWorkEnded>) {
                 m.apply();
+            } else if constexpr (std::is_same_v<T, PrintStatus>) {
+                // The booth goes on whatever the printer says: the operator sees it in the menu and the log.
+                if (m.problem) spdlog::warn("print: {}", m.line);
+                else spdlog::info("print: {}", m.line);
+                printerNews_ = m.line;
+                printerProblem_ = m.problem;
             } else if constexpr (std::is_same_v<T, FolderEnded>) {
                 if (m.error) spdlog::error("the session folder was not written: {}", m.error->what());
                 else spdlog::info("session folder written in {:.2f} s", m.seconds);
@@ -421,7 +440,12 @@ void Kiosk::runSession(const std::vector<session::Command>& commands, FlowTime n
                     } catch (const BoothError& e) {
                         done.error = e.what();
                     }
+                    // Keep prints when printing is on: once the toon strip is in the session (WriteStyleExtras,
+                    // perhaps run by this very handle()), or now when no strip is coming.
+                    if (printer_ && done.error.empty())
+                        cardAfterExtras_ = PrintCard{done.keptFolder, done.code, done.shareUrl};
                     runSession(lifecycle_.handle(done), now);
+                    if (cardAfterExtras_ && !lifecycle_.styleExtrasAwaited()) printCard(*std::exchange(cardAfterExtras_, {}));
                 } else if constexpr (std::is_same_v<T, session::DiscardFolder>) {
                     try {
                         store_.discard(c.folder);
@@ -436,6 +460,8 @@ void Kiosk::runSession(const std::vector<session::Command>& commands, FlowTime n
                         spdlog::error("the kept session {} goes without its toon strip: {}",
                                       c.keptFolder.filename().string(), e.what());
                     }
+                    if (cardAfterExtras_ && cardAfterExtras_->keptFolder == c.keptFolder)
+                        printCard(*std::exchange(cardAfterExtras_, {}));
                 } else if constexpr (std::is_same_v<T, session::TellFlow>) {
                     if (const auto* saved = std::get_if<SessionSaved>(&c.event)) {
                         ++report_.sessionsKept;
@@ -517,6 +543,8 @@ const cv::Mat& Kiosk::drawScreen(const ScreenModel& screen, KioskFigures::Frame&
         inputs.operatorInfo.sessionsStored = static_cast<int>(stored.size());
         inputs.operatorInfo.freeBytes = store_.freeBytes();
         inputs.operatorInfo.lastFreed = lastFreed_;
+        inputs.operatorInfo.printer = printerNews_;
+        inputs.operatorInfo.printerProblem = printerProblem_;
     }
     const cv::Mat& drawn = screens_.draw(screen, inputs);
     timing.composeEnd = std::chrono::steady_clock::now();
@@ -560,7 +588,18 @@ void Kiosk::finish() {
     if (lifecycle_.styleExtrasAwaited() && styles_.settled())
         runSession(lifecycle_.handle(session::StylesSettled{}), FlowClock::now());
     if (lifecycle_.styleExtrasAwaited()) spdlog::warn("a kept session goes without its toon strip: still drawing at the end");
+    // A card still waiting for its toon is printed without it; cards are sent before the booth ends (a run of N
+    // sessions; a stop does not wait for CUPS longer than its requests' own limits).
+    if (cardAfterExtras_) printCard(*std::exchange(cardAfterExtras_, {}));
+    if (printer_ && !printer_->waitSent(std::chrono::seconds(stopped ? 5 : 30)))
+        spdlog::warn("print: a card was still being sent at the end");
+    waitForMessages(std::chrono::steady_clock::now());
     report_.screenshots = screenshots_.written();
+}
+
+void Kiosk::printCard(PrintCard card) {
+    spdlog::info("print: card {} queued", card.code);
+    printer_->print(std::move(card));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // The simulated booth end to end: `avatarbooth run` with the sim camera, sim buttons, a headless display and the
 // simulated visitor runs one whole session, keeps it under a code, and writes a screenshot of every screen.
+#include "cups_server.h"
 #include "run_binary.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <array>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <regex>
 
 namespace fs = std::filesystem;
@@ -39,10 +41,18 @@ TEST(KioskSim, OneScriptedSessionEndToEnd) {
     const fs::path config = dir / "booth.toml";
     // With the visitor's page on (issue 23): the thanks screen shows its QR code (nothing listens: that is
     // `avatarbooth share`'s job, tests/e2e/share_*_test.cpp).
+    // With the card printer on too: a CUPS of the test's own when it runs as root with the packages (the card comes
+    // out of its PDF printer), else a scheduler that is not there (the booth goes on and says the card did not print).
+    std::optional<CupsServer> cups;
+    if (CupsServer::missing().empty()) cups.emplace(dir / "cups");
+    else std::printf("printing to a missing CUPS scheduler: %s\n", CupsServer::missing().c_str());
+    if (!cups) setenv("CUPS_SERVER", (dir / "no-cupsd.sock").c_str(), 1);
     std::ofstream(config) << "[camera]\nbackend = \"sim\"\n[buttons]\nbackend = \"sim\"\n[display]\nbackend = \"headless\"\n"
                           << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n"
-                          << "[share]\nenabled = true\nlisten = \"127.0.0.1:8099\"\n";
+                          << "[share]\nenabled = true\nlisten = \"127.0.0.1:8099\"\n"
+                          << "[print]\nenabled = true\nqueue = \"" << (cups ? cups->queue() : "photo") << "\"\n";
     const CommandResult r = runAvatarbooth("run --config " + config.string() + " --sessions 1 --screenshots " + (dir / "screens").string());
+    if (!cups) unsetenv("CUPS_SERVER");
     ASSERT_EQ(r.exitCode, 0) << r.output;
 
     // Kept under the code the thanks screen showed, complete, readable only by the booth's user.
@@ -67,6 +77,25 @@ TEST(KioskSim, OneScriptedSessionEndToEnd) {
         std::smatch token;
         ASSERT_TRUE(std::regex_search(info, token, std::regex("\"share_token\": \"([0-9a-f]{32})\""))) << info;
         EXPECT_EQ(qr, "http://127.0.0.1:8099/s/" + token[1].str() + "\n");
+        // Keep printed the card: it is in the session, and (with a real CUPS) its QR code comes out of the printer.
+        EXPECT_TRUE(fs::is_regular_file(session / "card.pdf")) << r.output;
+        if (cups) {
+            ASSERT_TRUE(cups->ok()) << cups->log();
+            EXPECT_NE(r.output.find("print: card " + m[1].str() + " sent"), std::string::npos) << r.output;
+            fs::path printed;
+            for (int i = 0; i < 300 && printed.empty(); ++i) {
+                for (const auto& e : fs::directory_iterator(cups->out()))
+                    if (e.path().extension() == ".pdf") printed = e.path();
+                if (printed.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+            }
+            ASSERT_FALSE(printed.empty()) << "nothing came out of the printer\n" << cups->log();
+            const fs::path page = dir / "printed";
+            run("pdftoppm -r 100 -png -singlefile '" + printed.string() + "' '" + page.string() + "'");
+            EXPECT_EQ(run("zbarimg --raw -q '" + page.string() + ".png'", false).out, qr);
+        } else {
+            EXPECT_NE(r.output.find("print: card " + m[1].str() + " not printed: no CUPS scheduler"), std::string::npos)
+                << r.output;
+        }
     }
 
     // A screenshot of every screen of the session, in the order shown.

@@ -727,6 +727,10 @@ void ScreenRenderer::operatorMenu(const ScreenModel& m, const ScreenInputs& in) 
             drawText(s, {margin, y, W - 2 * margin, static_cast<int>(rowH * 0.7)}, static_cast<int>(30 * u), kGrey);
             y += static_cast<int>(rowH * 0.7);
         }
+        if (!info.printer.empty())
+            drawText(strings_.format(settings_.language, "operator.printer", {{"state", info.printer}}),
+                     {margin, y, W - 2 * margin, static_cast<int>(rowH * 0.7)}, static_cast<int>(30 * u),
+                     info.printerProblem ? kRetakeRed : kGrey);
         drawText(str("operator.help"), {0, H - static_cast<int>(80 * u), W, static_cast<int>(60 * u)},
                  static_cast<int>(30 * u), kSoftWhite);
         return;

@@ -46,6 +46,8 @@ struct OperatorInfo {
     int sessionsStored = 0;
     std::uintmax_t freeBytes = 0;
     RetentionReport lastFreed;  // what the last FreeDisk did
+    std::string printer;        // the printer's last news ([print] on; "" = printing off)
+    bool printerProblem = false;  // ... and whether the operator has to act on it (shown in red)
 };
 
 struct ScreenInputs {

@@ -71,6 +71,7 @@ constexpr std::string_view kRequired[] = {
     "operator.sessions",
     "operator.free",
     "operator.freed",
+    "operator.printer",
     "operator.camera_ok",
     "operator.camera_lost",
 };
