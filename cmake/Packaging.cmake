@@ -71,7 +71,7 @@ set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 # (the landmark model, fonts, Mesa's EGL and GL drivers) and the tools the maintainer scripts use, by name.
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libdlib-data, opencv-data, fonts-dejavu-core, fonts-vlgothic, libegl-mesa0, libgl1-mesa-dri, systemd, udev")
+    "libdlib-data, opencv-data, fonts-dejavu-core, fonts-vlgothic, libegl-mesa0, libgl1-mesa-dri, sound-theme-freedesktop, systemd, udev")
 # cups: the printed card ([print]) goes to a CUPS queue, on this machine or another (libcups2 itself comes from
 # dpkg-shlibdeps).
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "device-tree-compiler, libcamera-tools, v4l-utils, gpiod, cups")

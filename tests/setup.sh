@@ -25,6 +25,9 @@ packages=(
   libqrencode-dev libcpp-httplib-dev
   # the printed card (issue 23): laid out with Cairo into a PDF, sent to CUPS with libcups
   libcairo2-dev libcups2-dev
+  # the booth's sounds: ALSA, the freedesktop theme's Ogg Vorbis clips (libvorbisfile) brought to 48 kHz
+  # (libsamplerate), and the theme itself (loaded at run time)
+  libasound2-dev libvorbis-dev libsamplerate0-dev sound-theme-freedesktop
   # (the build's configuration looks for the test and benchmark libraries)
   libgtest-dev libgmock-dev libbenchmark-dev
   systemd device-tree-compiler

@@ -21,6 +21,7 @@
 #include "booth/screens/strings.h"
 #include "booth/share_link.h"
 #include "print/cups_queue.h"
+#include "drivers/sound/sound_player.h"
 
 #include <nlohmann/json.hpp>
 
@@ -325,6 +326,32 @@ void checkPrint(const PrintSettings& print, Report& report) {
     else report.ok("print", what);
 }
 
+// The sounds ([sound]): off, or the sound cards ALSA finds and whether the sound theme's clips are there. Nothing
+// is opened (a running booth holds the device); without a card the booth is silent, which is worth a warning.
+void checkSound(const SoundSettings& sound, Report& report) {
+    if (!sound.enabled) {
+        report.ok("sound", "off ([sound] enabled = false)");
+        return;
+    }
+    const std::vector<std::string> cards = soundCards();
+    std::string what = "device " + sound.device + ", volume " + std::to_string(sound.volume) + "%; ";
+    if (cards.empty()) what += "no sound card found";
+    else {
+        what += "sound card";
+        for (const auto& c : cards) what += " " + c + ";";
+        what.pop_back();
+    }
+    for (const char* clip : {"camera-shutter.oga", "complete.oga"}) {
+        const fs::path file = fs::path(sound.themeDir) / clip;
+        if (!fs::exists(file)) {
+            report.warn("sound", what + "; " + file.string() + " is missing (sound-theme-freedesktop): silent");
+            return;
+        }
+    }
+    if (cards.empty() && sound.device == "default") report.warn("sound", what + ": the booth is silent");
+    else report.ok("sound", what);
+}
+
 }  // namespace
 
 void registerCheckCommand(CLI::App& app) {
@@ -349,6 +376,7 @@ void registerCheckCommand(CLI::App& app) {
         checkSessions(config.sessions.directory, report);
         checkShare(config.share, config.sessions, report);
         checkPrint(config.print, report);
+        checkSound(config.sound, report);
 
         std::optional<ErrorKind> firstFailure;
         int fails = 0, warns = 0;

@@ -17,6 +17,7 @@
 #include "drivers/camera/camera_settings.h"
 #include "drivers/display/display_settings.h"
 #include "drivers/gpio/gpio_settings.h"
+#include "drivers/sound/sound_settings.h"
 #include "fit/head/base_head.h"
 #include "reveal/character/character_head.h"
 #include "reveal/styles/style_settings.h"
@@ -62,6 +63,7 @@ struct BoothConfig {
     StageSettings stage;            // [stage]
     ShareSettings share;            // [share]
     PrintSettings print;            // [print]
+    SoundSettings sound;            // [sound]
 };
 
 // Every mistake in a configuration file, in line order, each a BoothError(BadConfig) "FILE:LINE: key: what is

@@ -339,6 +339,9 @@ std::vector<ConfigTable> makeTables() {
                  .doc = "The printed card (off by default): Keep prints the visitor's three styles, the short code and "
                         "the QR code of their page through a CUPS queue. The README's \"Take it home\" section sets up "
                         "the printer."});
+    t.push_back({.name = "sound",
+                 .doc = "The booth's sounds: a beep on each number of the countdown, the shutter, a chime at the "
+                        "reveal. On when the booth has a sound card."});
     return t;
 }
 
@@ -677,6 +680,18 @@ void addPrintKeys(std::vector<ConfigKey>& k) {
     k.push_back(integer("print", "copies", FIELD(print.copies), 1, 10, "Cards printed per kept session."));
 }
 
+void addSoundKeys(std::vector<ConfigKey>& k) {
+    // [sound]
+    k.push_back(flag("sound", "enabled", FIELD(sound.enabled),
+                     "Sounds when the booth has a sound card (false: silent whatever it has)."));
+    k.push_back(integer("sound", "volume", FIELD(sound.volume), 0, 100,
+                        "Loudness of the booth's sounds, percent of their own level (the card's mixer is left as "
+                        "it is: set it once with alsamixer)."));
+    k.push_back(text("sound", "device", FIELD(sound.device),
+                     "The ALSA output (`aplay -L` lists them): \"default\" (the first sound card), \"hw:1\", ...; "
+                     "\"file:FILE=/tmp/booth.wav,FORMAT=wav\" records the sounds instead."));
+}
+
 std::vector<ConfigKey> makeKeys() {
     std::vector<ConfigKey> k;
     addFitKeys(k);
@@ -693,6 +708,7 @@ std::vector<ConfigKey> makeKeys() {
     addStageKeys(k);
     addShareKeys(k);
     addPrintKeys(k);
+    addSoundKeys(k);
     return k;
 }
 

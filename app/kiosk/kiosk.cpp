@@ -13,6 +13,7 @@
 #include "drivers/display/headless_egl.h"
 #include "common/clock.h"
 #include "drivers/gpio/lamps.h"
+#include "kiosk/booth_sounds.h"
 #include "kiosk/fit_worker.h"
 #include "kiosk/kiosk_figures.h"
 #include "kiosk/kiosk_inputs.h"
@@ -139,6 +140,7 @@ private:
     RevealStyles styles_;
     StyleWorker styleWorker_;  // after the styles: its work posts to them, it ends first
     std::optional<PrintWorker> printer_;  // [print] on: each kept session's card
+    std::unique_ptr<BoothSounds> sounds_;  // null: silent ([sound] off, no sound card)
     std::optional<WatchdogPinger> watchdog_;  // from READY on
 
     // The visitor.
@@ -194,6 +196,11 @@ Kiosk::Kiosk(const BoothConfig& config, const KioskOptions& options, SteadyClock
     note("buttons: " + board_.description);
     note("sessions: " + config.sessions.directory.string());
     report_.sessionsDirectory = config.sessions.directory;
+    {
+        std::string said;
+        sounds_ = BoothSounds::open(config.sound, said);
+        note("sound: " + said);
+    }
     if (config.print.enabled) {
         printer_.emplace(config.print, queue_);
         printerNews_ = "on, queue " + (config.print.queue.empty() ? std::string("(CUPS default)") : config.print.queue);
@@ -223,6 +230,7 @@ KioskReport Kiosk::run() {
         runSession(lifecycle_.handle(session::TimePassed{std::chrono::steady_clock::now()}), now);
         step.mark("fit");
         runFlow(now);
+        if (sounds_) sounds_->screen(flow_.screen());
         lamps_.update(clock_.now());
         step.mark("flow");
 

@@ -29,7 +29,7 @@ sysroot_packages=(
   libcli11-dev libspdlog-dev libtomlplusplus-dev libsystemd-dev libgpiod-dev libcamera-dev
   libfreetype-dev libpng-dev libexif-dev libstb-dev zlib1g-dev
   libqrencode-dev libcpp-httplib-dev
-  libcairo2-dev libcups2-dev
+  libcairo2-dev libcups2-dev libasound2-dev libvorbis-dev libsamplerate0-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

@@ -57,6 +57,11 @@ TEST(CheckCli, SimulatedBoothIsReady) {
     EXPECT_NE(messagesOf(report, "sessions").find("MB free"), std::string::npos);
     EXPECT_EQ(messagesOf(report, "share").rfind("off ([share] enabled = false)", 0), 0u) << messagesOf(report, "share");
     EXPECT_EQ(messagesOf(report, "print").rfind("off ([print] enabled = false)", 0), 0u) << messagesOf(report, "print");
+    // The sound card: this machine has none (a container) or some; either way the check says which.
+    const std::string sound = messagesOf(report, "sound");
+    EXPECT_NE(sound.find("device default, volume 80%; "), std::string::npos) << sound;
+    EXPECT_TRUE(sound.find("no sound card found") != std::string::npos || sound.find("sound card 0: ") != std::string::npos)
+        << sound;
     EXPECT_NE(messagesOf(report, "landmarks").find("loads"), std::string::npos);
     // The sim camera is OK whatever real cameras this machine has.
     EXPECT_EQ(statusesOf(report, "camera").back(), "OK");

@@ -2,6 +2,7 @@
 // simulated visitor runs one whole session, keeps it under a code, and writes a screenshot of every screen.
 #include "cups_server.h"
 #include "run_binary.h"
+#include "wav_onsets.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -50,7 +51,9 @@ TEST(KioskSim, OneScriptedSessionEndToEnd) {
     std::ofstream(config) << "[camera]\nbackend = \"sim\"\n[buttons]\nbackend = \"sim\"\n[display]\nbackend = \"headless\"\n"
                           << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n"
                           << "[share]\nenabled = true\nlisten = \"127.0.0.1:8099\"\n"
-                          << "[print]\nenabled = true\nqueue = \"" << (cups ? cups->queue() : "photo") << "\"\n";
+                          << "[print]\nenabled = true\nqueue = \"" << (cups ? cups->queue() : "photo") << "\"\n"
+                          // and the sounds, recorded by ALSA's file output
+                          << "[sound]\ndevice = \"file:FILE=" << (dir / "sound.wav").string() << ",FORMAT=wav\"\n";
     const CommandResult r = runAvatarbooth("run --config " + config.string() + " --sessions 1 --screenshots " + (dir / "screens").string());
     if (!cups) unsetenv("CUPS_SERVER");
     ASSERT_EQ(r.exitCode, 0) << r.output;
@@ -97,6 +100,24 @@ TEST(KioskSim, OneScriptedSessionEndToEnd) {
                 << r.output;
         }
     }
+
+    // What the visitor heard: three beeps a second apart for each photo's countdown, each photo's shutter, and the
+    // reveal's chime, which here follows the side photo's shutter within a few tenths of a second (the simulated
+    // fit is quick): the sound after that shutter lasts as long as the chime (1.2 s), not the shutter's 0.35 s.
+    const Wav wav = readWav(dir / "sound.wav");
+    const std::vector<double> heard = onsets(wav);
+    std::string times;
+    for (double t : heard) times += " " + std::to_string(t);
+    std::printf("sounds heard at (s):%s\n", times.c_str());
+    ASSERT_GE(heard.size(), 8u) << times << "\n" << r.output;
+    ASSERT_LE(heard.size(), 9u) << times << "\n" << r.output;
+    for (std::size_t first : {0u, 4u})
+        for (std::size_t i = first; i < first + 2; ++i)
+            EXPECT_NEAR(heard[i + 1] - heard[i], 1.0, 0.07) << "countdown beeps a second apart:" << times;
+    std::size_t lastSound = 0;
+    for (std::size_t i = 0; i < wav.samples.size(); ++i)
+        if (std::abs(int{wav.samples[i]}) > 327) lastSound = i;
+    EXPECT_GT(static_cast<double>(lastSound) / wav.channels / wav.rate - heard[7], 0.8) << "the reveal's chime";
 
     // A screenshot of every screen of the session, in the order shown.
     std::vector<std::string> shown;

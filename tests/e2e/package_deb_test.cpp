@@ -64,7 +64,8 @@ TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
     EXPECT_EQ(field(info, "Package"), "avatarbooth");
     const std::string depends = field(info, "Depends");
     for (const char* p : {"libdlib-data", "libopencv-core", "libdlib19", "libgpiod2", "libcamera", "libsystemd0",
-                          "fonts-dejavu-core", "systemd", "libqrencode4", "libcpp-httplib0.11"})
+                          "fonts-dejavu-core", "systemd", "libqrencode4", "libcpp-httplib0.11", "libcairo2", "libcups2",
+                          "libasound2", "libvorbisfile3", "libsamplerate0", "sound-theme-freedesktop"})
         EXPECT_NE(depends.find(p), std::string::npos) << p << " not in Depends: " << depends;
     EXPECT_NE(info.find(" postinst "), std::string::npos) << info;
     EXPECT_NE(info.find(" conffiles "), std::string::npos) << info;

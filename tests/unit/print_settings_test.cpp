@@ -1,5 +1,5 @@
-// [print] in booth.toml (off by default, every key read, mistakes named by file, line and key) and how a CUPS
-// queue's state reads to the operator (print/cups_queue.h): which states are problems, and the words for them.
+// [print] and [sound] in booth.toml ([print] off and [sound] on by default, every key read, mistakes named by file,
+// line and key) and how a CUPS queue's state reads to the operator (print/cups_queue.h): problems, and their words.
 #include "config/booth_config.h"
 #include "config_error_of.h"
 #include "print/cups_queue.h"
@@ -89,4 +89,16 @@ TEST(PrintJobState, FinishedStatesAndWords) {
     j.state = JobState::State::Completed;
     j.reasons = {"job-completed-successfully"};
     EXPECT_EQ(j.describe(), "printed");
+}
+
+TEST(SoundConfig, OnByDefaultAndReadFromTheFile) {
+    const BoothConfig defaults;
+    EXPECT_TRUE(defaults.sound.enabled);
+    EXPECT_EQ(defaults.sound.volume, 80);
+    EXPECT_EQ(defaults.sound.device, "default");
+    const BoothConfig c = parseBoothConfig("[sound]\nenabled = false\nvolume = 30\ndevice = \"hw:1\"\n", "booth.toml");
+    EXPECT_FALSE(c.sound.enabled);
+    EXPECT_EQ(c.sound.volume, 30);
+    EXPECT_EQ(c.sound.device, "hw:1");
+    EXPECT_EQ(errorOf("[sound]\nvolume = 101\n"), "booth.toml:2: sound.volume: must be between 0 and 100, got 101");
 }
