@@ -23,6 +23,8 @@ packages=(
   libjpeg-dev libpng-dev libexif-dev libstb-dev zlib1g-dev
   # the visitor's page (issue 23): the thanks screen's QR code, and `avatarbooth share`'s HTTP(S) server
   libqrencode-dev libcpp-httplib-dev
+  # the visitor's page's turning picture: an animated WebP (WebPAnimEncoder)
+  libwebp-dev
   # the printed card (issue 23): laid out with Cairo into a PDF, sent to CUPS with libcups
   libcairo2-dev libcups2-dev
   # the booth's sounds: ALSA, the freedesktop theme's Ogg Vorbis clips (libvorbisfile) brought to 48 kHz

@@ -636,7 +636,8 @@ void addShareKeys(std::vector<ConfigKey>& k) {
                                        "A page answers this long after its session was kept (at most the session's "
                                        "retention); afterwards it answers like an unknown page."));
     k.push_back(flag("share", "downloads", FIELD(share.offerDownloads),
-                     "The page offers avatar.glb, avatar.usdz and the preview image for download."));
+                     "The page offers avatar.glb, avatar.usdz, the preview image and the turning picture (turntable.webp) for "
+                     "download."));
     k.push_back(flag("share", "photos", FIELD(share.offerPhotos),
                      "The page also offers the visitor's two photos while they are kept (personal data: only with "
                      "the visitors' consent)."));

@@ -22,6 +22,7 @@
 #include "kiosk/screenshots.h"
 #include "kiosk/session_writer.h"
 #include "kiosk/style_worker.h"
+#include "kiosk/turntable_worker.h"
 #include "kiosk/watchdog.h"
 #include "reveal/character/character_outputs.h"
 #include "reveal/styles/reveal_styles.h"
@@ -141,6 +142,7 @@ private:
     StyleWorker styleWorker_;  // after the styles: its work posts to them, it ends first
     std::optional<PrintWorker> printer_;  // [print] on: each kept session's card
     std::unique_ptr<BoothSounds> sounds_;  // null: silent ([sound] off, no sound card)
+    std::optional<TurntableWorker> turntables_;  // [share] on: each kept session's turntable.webp
     std::optional<WatchdogPinger> watchdog_;  // from READY on
 
     // The visitor.
@@ -201,6 +203,7 @@ Kiosk::Kiosk(const BoothConfig& config, const KioskOptions& options, SteadyClock
         sounds_ = BoothSounds::open(config.sound, said);
         note("sound: " + said);
     }
+    if (config.share.enabled) turntables_.emplace(queue_);
     if (config.print.enabled) {
         printer_.emplace(config.print, queue_);
         printerNews_ = "on, queue " + (config.print.queue.empty() ? std::string("(CUPS default)") : config.print.queue);
@@ -355,6 +358,14 @@ void Kiosk::handle(const KioskMessage& message, FlowTime now) {
                 else spdlog::info("print: {}", m.line);
                 printerNews_ = m.line;
                 printerProblem_ = m.problem;
+            } else if constexpr (std::is_same_v<T, TurntableEnded>) {
+                if (m.error)
+                    spdlog::warn("the kept session {} goes without its turntable picture: {}",
+                                 m.keptFolder.filename().string(), *m.error);
+                else
+                    spdlog::info("turntable.webp added to the kept session {}: {} KB, rendered in {:.2f} s, encoded in "
+                                 "{:.2f} s", m.keptFolder.filename().string(), m.bytes / 1024, m.renderSeconds,
+                                 m.encodeSeconds);
             } else if constexpr (std::is_same_v<T, FolderEnded>) {
                 if (m.error) spdlog::error("the session folder was not written: {}", m.error->what());
                 else spdlog::info("session folder written in {:.2f} s", m.seconds);
@@ -452,6 +463,8 @@ void Kiosk::runSession(const std::vector<session::Command>& commands, FlowTime n
                     // perhaps run by this very handle()), or now when no strip is coming.
                     if (printer_ && done.error.empty())
                         cardAfterExtras_ = PrintCard{done.keptFolder, done.code, done.shareUrl};
+                    // The visitor's page gets its turntable picture, made behind the thanks screen.
+                    if (turntables_ && done.error.empty()) turntables_->submit(done.keptFolder);
                     runSession(lifecycle_.handle(done), now);
                     if (cardAfterExtras_ && !lifecycle_.styleExtrasAwaited()) printCard(*std::exchange(cardAfterExtras_, {}));
                 } else if constexpr (std::is_same_v<T, session::DiscardFolder>) {
@@ -599,6 +612,7 @@ void Kiosk::finish() {
     // A card still waiting for its toon is printed without it; cards are sent before the booth ends (a run of N
     // sessions; a stop does not wait for CUPS longer than its requests' own limits).
     if (cardAfterExtras_) printCard(*std::exchange(cardAfterExtras_, {}));
+    if (turntables_ && !stopped) turntables_->waitIdle();
     if (printer_ && !printer_->waitSent(std::chrono::seconds(stopped ? 5 : 30)))
         spdlog::warn("print: a card was still being sent at the end");
     waitForMessages(std::chrono::steady_clock::now());

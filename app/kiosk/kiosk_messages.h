@@ -64,8 +64,16 @@ struct PrintStatus {
     bool problem = false;
 };
 
+// A kept session's turntable.webp was made (TurntableWorker), or not (`error`).
+struct TurntableEnded {
+    std::filesystem::path keptFolder;
+    std::size_t bytes = 0;
+    double renderSeconds = 0, encodeSeconds = 0;
+    std::optional<std::string> error;
+};
+
 using KioskMessage = std::variant<ModelLoaded, FitStepStarted, FitEnded, CharacterEnded, PreviewEnded, FolderEnded,
-                                  StyleWorkEnded, PrintStatus>;
+                                  StyleWorkEnded, PrintStatus, TurntableEnded>;
 using KioskQueue = MessageQueue<KioskMessage>;
 
 }  // namespace avatarbooth

@@ -74,6 +74,28 @@ PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size) {
     return set;
 }
 
+std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames) {
+    checkUploaded(renderer, mesh, size);
+    glm::dvec3 lo, hi;
+    mesh.bounds(lo, hi);
+    const glm::dvec3 centre = (lo + hi) * 0.5;
+    double radius = 1.0;
+    for (const auto& p : mesh.positions) radius = std::max(radius, glm::length(p - centre));
+    const double mmPerPixel = 2.0 * radius * (1.0 + 2.0 * kMargin) / size;
+    const double elevation = glm::radians(10.0);
+    std::vector<cv::Mat> out;
+    for (int i = 0; i < frames; ++i) {
+        const double a = 2.0 * 3.14159265358979323846 * i / frames;
+        const glm::dvec3 back(-std::sin(a) * std::cos(elevation), std::sin(elevation), std::cos(a) * std::cos(elevation));
+        RenderCamera camera = RenderCamera::orthographic(centre + back * (2.0 * radius + 100.0), centre,
+                                                         {0.0, 1.0, 0.0}, mmPerPixel, size, size);
+        camera.background = kBackground;
+        camera.lit = true;
+        out.push_back(renderer.render(camera).bgr);
+    }
+    return out;
+}
+
 cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size) {
     checkUploaded(renderer, mesh, size);
     return renderer.render(framedCamera(mesh, threeQuarterDirection(), {0.0, 1.0, 0.0}, size)).bgr;

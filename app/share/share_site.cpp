@@ -43,6 +43,7 @@ const char* contentTypeOf(const std::string& name) {
     if (ext == ".usdz") return "model/vnd.usdz+zip";
     if (ext == ".png") return "image/png";
     if (ext == ".jpg") return "image/jpeg";
+    if (ext == ".webp") return "image/webp";
     return "application/octet-stream";
 }
 
@@ -245,8 +246,8 @@ ShareResponse ShareSite::answer(const std::string& method, const std::string& pa
     // One URL per thing: the page is "/s/TOKEN" exactly (the QR code's), a file "/s/TOKEN/NAME".
     if (!rest.empty() && (rest.size() < 2 || rest[0] != '/')) return notFound();
     const std::string name = rest.empty() ? "" : rest.substr(1);
-    static const std::vector<std::string> files{"avatar.glb", "avatar.usdz", "preview.png", "front.jpg",
-                                                "front.png",  "side.jpg",    "side.png"};
+    static const std::vector<std::string> files{"avatar.glb", "avatar.usdz", "preview.png", "turntable.webp",
+                                                "front.jpg",  "front.png",   "side.jpg",    "side.png"};
     if (!name.empty() && std::find(files.begin(), files.end(), name) == files.end()) return notFound();
     try {
         const auto session = index_.find(token);
@@ -278,6 +279,7 @@ ShareResponse ShareSite::page(const std::string& token, const SessionIndex::Entr
     std::error_code ec;
     const bool hasUsdz = fs::is_regular_file(folder / "avatar.usdz", ec);
     const bool hasPreview = fs::is_regular_file(folder / "preview_three_quarter.png", ec);
+    const bool hasTurntable = fs::is_regular_file(folder / "turntable.webp", ec);
     std::string h;
     h += "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
          "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
@@ -301,6 +303,8 @@ ShareResponse ShareSite::page(const std::string& token, const SessionIndex::Entr
         links.emplace_back(base + "avatar.glb", "3-D model<small>avatar.glb (glTF: Android, Windows, Blender)</small>");
         if (hasUsdz) links.emplace_back(base + "avatar.usdz", "3-D model for iPhone and iPad<small>avatar.usdz</small>");
         if (hasPreview) links.emplace_back(base + "preview.png", "Picture<small>avatar-preview.png</small>");
+        if (hasTurntable)
+            links.emplace_back(base + "turntable.webp", "Turning picture<small>avatar-turntable.webp (animated)</small>");
     }
     if (share_.offerPhotos)
         for (const char* stem : {"front", "side"})

@@ -80,6 +80,11 @@ TEST(KioskSim, OneScriptedSessionEndToEnd) {
         std::smatch token;
         ASSERT_TRUE(std::regex_search(info, token, std::regex("\"share_token\": \"([0-9a-f]{32})\""))) << info;
         EXPECT_EQ(qr, "http://127.0.0.1:8099/s/" + token[1].str() + "\n");
+        // The page's turning picture, made after the keep.
+        EXPECT_TRUE(fs::is_regular_file(session / "turntable.webp")) << r.output;
+        std::smatch made;
+        if (std::regex_search(r.output, made, std::regex("turntable.webp added to the kept session [^\n]*")))
+            std::printf("%s\n", made[0].str().c_str());
         // Keep printed the card: it is in the session, and (with a real CUPS) its QR code comes out of the printer.
         EXPECT_TRUE(fs::is_regular_file(session / "card.pdf")) << r.output;
         if (cups) {

@@ -65,7 +65,8 @@ TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
     const std::string depends = field(info, "Depends");
     for (const char* p : {"libdlib-data", "libopencv-core", "libdlib19", "libgpiod2", "libcamera", "libsystemd0",
                           "fonts-dejavu-core", "systemd", "libqrencode4", "libcpp-httplib0.11", "libcairo2", "libcups2",
-                          "libasound2", "libvorbisfile3", "libsamplerate0", "sound-theme-freedesktop"})
+                          "libasound2", "libvorbisfile3", "libsamplerate0", "sound-theme-freedesktop",
+                          "libwebpmux3"})
         EXPECT_NE(depends.find(p), std::string::npos) << p << " not in Depends: " << depends;
     EXPECT_NE(info.find(" postinst "), std::string::npos) << info;
     EXPECT_NE(info.find(" conffiles "), std::string::npos) << info;
