@@ -49,10 +49,10 @@ std::unique_ptr<BoothSounds> BoothSounds::open(const SoundSettings& settings, st
     }
 }
 
-void BoothSounds::screen(const ScreenModel& screen) {
+void BoothSounds::screen(const ScreenModel& screen, SoundPlayer::Time when) {
     const auto cue = cues_.screen(screen);
     if (!cue) return;
-    player_.play(*cue == SoundCue::Tick ? tick_ : *cue == SoundCue::Shutter ? shutter_ : reveal_);
+    player_.play(*cue == SoundCue::Tick ? tick_ : *cue == SoundCue::Shutter ? shutter_ : reveal_, when);
 }
 
 }  // namespace avatarbooth

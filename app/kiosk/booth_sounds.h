@@ -32,8 +32,8 @@ public:
     // booth goes on silently).
     static std::unique_ptr<BoothSounds> open(const SoundSettings& settings, std::string& note);
 
-    // Plays the cue of `screen`, if it has one (returns at once).
-    void screen(const ScreenModel& screen);
+    // Plays the cue of `screen`, if it has one, as of `when` (the moment the screen changed; returns at once).
+    void screen(const ScreenModel& screen, SoundPlayer::Time when = std::chrono::steady_clock::now());
 
     SoundPlayer& player() { return player_; }
 

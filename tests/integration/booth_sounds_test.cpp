@@ -94,7 +94,7 @@ TEST(BoothSounds, RecordedWavHasTheBeepsAtTheCountdownsTimes) {
         for (const auto& [at, screen] : script) {
             std::this_thread::sleep_until(started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(at)));
             const auto now = Clock::now();
-            sounds->screen(screen);
+            sounds->screen(screen, now);
             if (screen.id != ScreenId::FrontGuide && screen.id != ScreenId::Processing)
                 asked.push_back(std::chrono::duration<double>(now - started).count());
         }
