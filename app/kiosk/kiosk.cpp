@@ -233,7 +233,7 @@ KioskReport Kiosk::run() {
         runSession(lifecycle_.handle(session::TimePassed{std::chrono::steady_clock::now()}), now);
         step.mark("fit");
         runFlow(now);
-        if (sounds_) sounds_->screen(flow_.screen());
+        if (sounds_) sounds_->screen(flow_.screen(), now);  // as of this loop step, when the screen changed
         lamps_.update(clock_.now());
         step.mark("flow");
 
