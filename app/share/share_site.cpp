@@ -44,6 +44,7 @@ const char* contentTypeOf(const std::string& name) {
     if (ext == ".png") return "image/png";
     if (ext == ".jpg") return "image/jpeg";
     if (ext == ".webp") return "image/webp";
+    if (ext == ".pdf") return "application/pdf";
     return "application/octet-stream";
 }
 
@@ -247,7 +248,8 @@ ShareResponse ShareSite::answer(const std::string& method, const std::string& pa
     if (!rest.empty() && (rest.size() < 2 || rest[0] != '/')) return notFound();
     const std::string name = rest.empty() ? "" : rest.substr(1);
     static const std::vector<std::string> files{"avatar.glb", "avatar.usdz", "preview.png", "turntable.webp",
-                                                "front.jpg",  "front.png",   "side.jpg",    "side.png"};
+                                                "card.pdf",   "front.jpg",   "front.png",   "side.jpg",
+                                                "side.png"};
     if (!name.empty() && std::find(files.begin(), files.end(), name) == files.end()) return notFound();
     try {
         const auto session = index_.find(token);
@@ -280,6 +282,7 @@ ShareResponse ShareSite::page(const std::string& token, const SessionIndex::Entr
     const bool hasUsdz = fs::is_regular_file(folder / "avatar.usdz", ec);
     const bool hasPreview = fs::is_regular_file(folder / "preview_three_quarter.png", ec);
     const bool hasTurntable = fs::is_regular_file(folder / "turntable.webp", ec);
+    const bool hasCard = fs::is_regular_file(folder / "card.pdf", ec);  // printed at the booth ([print])
     std::string h;
     h += "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
          "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
@@ -305,6 +308,7 @@ ShareResponse ShareSite::page(const std::string& token, const SessionIndex::Entr
         if (hasPreview) links.emplace_back(base + "preview.png", "Picture<small>avatar-preview.png</small>");
         if (hasTurntable)
             links.emplace_back(base + "turntable.webp", "Turning picture<small>avatar-turntable.webp (animated)</small>");
+        if (hasCard) links.emplace_back(base + "card.pdf", "The printed card<small>avatar-card.pdf</small>");
     }
     if (share_.offerPhotos)
         for (const char* stem : {"front", "side"})

@@ -13,6 +13,7 @@
 #include "kiosk/print_worker.h"
 #include "print/card.h"
 #include "print/cups_queue.h"
+#include "share/share_site.h"
 #include "cups_server.h"
 #include "test_paths.h"
 
@@ -274,6 +275,17 @@ TEST(PrintCups, KeptSessionsCardComesOutOfCupsPdfAndItsTimeIsPrinted) {
     ASSERT_TRUE(fs::is_regular_file(kept.folder / "card.pdf")) << "the card is kept in the session";
     expectCard(kept.folder / "card.pdf", kept);
     expectCard(pdf, kept, false);
+    // The visitor's page offers the card it printed.
+    ShareSettings share;
+    share.enabled = true;
+    SessionStoreSettings sessions;
+    sessions.directory = dir / "sessions";
+    ShareSite site(share, sessions, "");
+    const std::string token = readShareToken(kept.folder).value();
+    EXPECT_NE(site.answer("GET", "/s/" + token, std::chrono::system_clock::now()).body.find("/card.pdf"), std::string::npos);
+    const ShareResponse card = site.answer("GET", "/s/" + token + "/card.pdf", std::chrono::system_clock::now());
+    EXPECT_EQ(card.status, 200);
+    EXPECT_EQ(card.contentType, "application/pdf");
     // What came out is the card that was sent, but for Ghostscript's resampling (the page up to a pixel or two away
     // and a row shorter): closer to it, in the code's box, than to the same card with another code.
     const PrintSettings settings = cardSettings(cups.queue());
@@ -350,7 +362,7 @@ TEST(PrintCups, RejectingQueueRefusesTheCardWithTheReason) {
     EXPECT_NE(queryQueue("no-such-queue").describe().find("no print queue"), std::string::npos);
 }
 
-TEST(PrintCups, HeldJobIsReported) {
+TEST(PrintCups, HeldAndCanceledJobsAreReported) {
     REQUIRE_CUPS();
     const fs::path dir = test::scratchDir("print_cups_held");
     CupsServer cups(dir / "cups");
@@ -367,4 +379,10 @@ TEST(PrintCups, HeldJobIsReported) {
     EXPECT_EQ(j.state, JobState::State::Held) << j.describe();
     EXPECT_FALSE(j.finished());
     EXPECT_NE(j.describe().find("held"), std::string::npos) << j.describe();
+    // Canceled by the operator (cancel): finished, and told as such.
+    ASSERT_TRUE(cups.command("/usr/bin/cancel " + cups.queue() + "-" + m[1].str()));
+    const JobState canceled = queryJob(std::stoi(m[1]));
+    EXPECT_EQ(canceled.state, JobState::State::Canceled) << canceled.describe();
+    EXPECT_TRUE(canceled.finished());
+    EXPECT_EQ(canceled.describe().rfind("canceled", 0), 0u) << canceled.describe();
 }
