@@ -461,8 +461,11 @@ void Kiosk::runSession(const std::vector<session::Command>& commands, FlowTime n
                     }
                     // Keep prints when printing is on: once the toon strip is in the session (WriteStyleExtras,
                     // perhaps run by this very handle()), or now when no strip is coming.
-                    if (printer_ && done.error.empty())
+                    if (printer_ && done.error.empty()) {
+                        // An earlier visitor's card still waiting for its toon goes now, without it.
+                        if (cardAfterExtras_) printCard(*std::exchange(cardAfterExtras_, {}));
                         cardAfterExtras_ = PrintCard{done.keptFolder, done.code, done.shareUrl};
+                    }
                     // The visitor's page gets its turntable picture, made behind the thanks screen.
                     if (turntables_ && done.error.empty()) turntables_->submit(done.keptFolder);
                     runSession(lifecycle_.handle(done), now);
