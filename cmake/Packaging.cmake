@@ -1,7 +1,8 @@
 # Install rules and the Debian package (CPack DEB): `cmake --build build/release --target package` writes
 # build/release/avatarbooth_<version>_<arch>.deb. Installed layout (prefix /usr):
 #   /usr/bin/avatarbooth, /etc/avatarbooth/booth.toml (conffile), /usr/share/avatarbooth/strings.toml + stage.map,
-#   /usr/lib/systemd/system/avatarbooth.service (+ avatarbooth-retention.service/.timer), /usr/lib/tmpfiles.d/avatarbooth.conf,
+#   /usr/lib/systemd/system/avatarbooth.service (+ avatarbooth-retention.service/.timer, avatarbooth-share.service),
+#   /usr/share/avatarbooth/model-viewer/ (the visitors' pages' 3-D viewer), /usr/lib/tmpfiles.d/avatarbooth.conf,
 #   /usr/lib/sysusers.d/avatarbooth.conf, /usr/lib/udev/rules.d/60-avatarbooth.rules,
 #   /usr/share/avatarbooth/firmware/ (overlay source, .dtbo when dtc was found, config.txt fragment),
 #   /usr/share/doc/avatarbooth/ (README, copyright).
@@ -22,7 +23,14 @@ install(FILES ${CMAKE_SOURCE_DIR}/app/assets/strings.toml ${CMAKE_SOURCE_DIR}/ap
 # The config lives in /etc whatever the prefix: it is the operator's file (a dpkg conffile, kept on upgrade).
 install(FILES ${CMAKE_SOURCE_DIR}/app/assets/booth.toml DESTINATION /etc/avatarbooth)
 install(FILES ${CMAKE_SOURCE_DIR}/systemd/avatarbooth.service ${CMAKE_SOURCE_DIR}/systemd/avatarbooth-retention.service
-              ${CMAKE_SOURCE_DIR}/systemd/avatarbooth-retention.timer DESTINATION lib/systemd/system)
+              ${CMAKE_SOURCE_DIR}/systemd/avatarbooth-retention.timer ${CMAKE_SOURCE_DIR}/systemd/avatarbooth-share.service
+        DESTINATION lib/systemd/system)
+# <model-viewer> (npm, Apache-2.0, bundling three.js, MIT) for the visitors' pages (`avatarbooth share`) and the batch
+# report: installed when tests/setup.sh has fetched it; without it the pages offer the downloads only.
+set(AVATARBOOTH_MODEL_VIEWER_JS ${CMAKE_SOURCE_DIR}/app/assets/report/node_modules/@google/model-viewer/dist/model-viewer-umd.min.js)
+if(EXISTS ${AVATARBOOTH_MODEL_VIEWER_JS})
+  install(FILES ${AVATARBOOTH_MODEL_VIEWER_JS} DESTINATION share/avatarbooth/model-viewer)
+endif()
 install(FILES ${CMAKE_SOURCE_DIR}/systemd/avatarbooth.tmpfiles DESTINATION lib/tmpfiles.d RENAME avatarbooth.conf)
 install(FILES ${CMAKE_SOURCE_DIR}/systemd/avatarbooth.sysusers DESTINATION lib/sysusers.d RENAME avatarbooth.conf)
 install(FILES ${CMAKE_SOURCE_DIR}/firmware/60-avatarbooth.rules DESTINATION lib/udev/rules.d)
@@ -50,7 +58,9 @@ set(CPACK_PACKAGE_CONTACT "avatarbooth maintainers <avatarbooth@localhost>")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "photo-booth kiosk that turns a front and a side photo into a 3-D head")
 set(CPACK_PACKAGE_DESCRIPTION "A visitor presses a button, a front and a side photo are taken, and a textured
  3-D head avatar is fitted (NTT method) and shown turning on the booth's screen. Runs as the systemd service
- avatarbooth.service (not enabled on install: systemctl enable --now avatarbooth avatarbooth-retention.timer). Run `avatarbooth check` first.")
+ avatarbooth.service (not enabled on install: systemctl enable --now avatarbooth avatarbooth-retention.timer). Run `avatarbooth check` first.
+ The visitors' own pages (a QR code on the thanks screen) are off unless [share] is enabled in booth.toml and
+ avatarbooth-share.service is enabled.")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 # Debug info stays in the build tree: the booth needs none of it.
@@ -61,8 +71,10 @@ set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 # (the landmark model, fonts, Mesa's EGL and GL drivers) and the tools the maintainer scripts use, by name.
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libdlib-data, opencv-data, fonts-dejavu-core, fonts-vlgothic, libegl-mesa0, libgl1-mesa-dri, systemd, udev")
-set(CPACK_DEBIAN_PACKAGE_SUGGESTS "device-tree-compiler, libcamera-tools, v4l-utils, gpiod")
+    "libdlib-data, opencv-data, fonts-dejavu-core, fonts-vlgothic, libegl-mesa0, libgl1-mesa-dri, sound-theme-freedesktop, systemd, udev")
+# cups: the printed card ([print]) goes to a CUPS queue, on this machine or another (libcups2 itself comes from
+# dpkg-shlibdeps).
+set(CPACK_DEBIAN_PACKAGE_SUGGESTS "device-tree-compiler, libcamera-tools, v4l-utils, gpiod, cups")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
     ${CMAKE_SOURCE_DIR}/packaging/postinst ${CMAKE_SOURCE_DIR}/packaging/postrm ${CMAKE_SOURCE_DIR}/packaging/conffiles)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)

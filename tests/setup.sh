@@ -21,6 +21,15 @@ packages=(
   libfreetype-dev fonts-dejavu-core fonts-vlgothic
   # image files (app/common/image_codec): libjpeg-turbo, libpng, libexif (orientation), stb_image (BMP)
   libjpeg-dev libpng-dev libexif-dev libstb-dev zlib1g-dev
+  # the visitor's page (issue 23): the thanks screen's QR code, and `avatarbooth share`'s HTTP(S) server
+  libqrencode-dev libcpp-httplib-dev
+  # the visitor's page's turning picture: an animated WebP (WebPAnimEncoder)
+  libwebp-dev
+  # the printed card (issue 23): laid out with Cairo into a PDF, sent to CUPS with libcups
+  libcairo2-dev libcups2-dev
+  # the booth's sounds: ALSA, the freedesktop theme's Ogg Vorbis clips (libvorbisfile) brought to 48 kHz
+  # (libsamplerate), and the theme itself (loaded at run time)
+  libasound2-dev libvorbis-dev libsamplerate0-dev sound-theme-freedesktop
   # (the build's configuration looks for the test and benchmark libraries)
   libgtest-dev libgmock-dev libbenchmark-dev
   systemd device-tree-compiler
@@ -37,6 +46,11 @@ test_packages=(
   clang-14 libclang-rt-14-dev
   # the e2e test of the development window runs it under a virtual X server
   xvfb
+  # the thanks screen's QR code is read back from its screenshot (zbarimg)
+  zbar-tools
+  # the printed card's tests start their own CUPS scheduler with a PDF printer (cups-pdf, which pulls in cups-filters
+  # and Ghostscript) and read the PDF back (pdfinfo, pdftotext, pdftoppm)
+  cups-daemon cups-client printer-driver-cups-pdf poppler-utils
   # the `kernel` tests (tests/kernel/): qemu boots Debian's kernel; busybox/cpio/kmod make its initramfs and
   # module tree (modules built with gcc-12/make); v4l-utils, udev, libcamera-ipa/-tools are used inside the guest
   qemu-system-x86 busybox-static cpio kmod xz-utils make gcc-12 libc6-dev v4l-utils udev libcamera-ipa libcamera-tools

@@ -99,6 +99,7 @@ struct FitFailed {
 struct SessionSaved {
     std::string code;
     FlowTime t;
+    std::string shareUrl{};  // the visitor's page (booth/share_link.h); empty when sharing is off
 };
 struct SessionSaveFailed {
     std::string detail;
@@ -207,6 +208,7 @@ struct ScreenModel {
     double progress = 0.0;           // processing: 0..1
     std::optional<FitStep> fitStep;  // processing: the step the fit is in (none before the first)
     std::string code;                // thanks: the session's short code (empty while saving)
+    std::string shareUrl;            // thanks: the visitor's page, shown as a QR code (empty: sharing is off)
     BannerKind banner = BannerKind::None;
     FitFailure fitFailure = FitFailure::Other;  // with BannerKind::FitFailed
     std::string detail;              // the banner's technical detail (shown small on the camera-lost screen)

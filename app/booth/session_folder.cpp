@@ -1,5 +1,7 @@
-// Writing the session folder: avatar.glb, the photos, overlays, previews, landmarks.json, the character, fit.json.
+// Writing the session folder: avatar.glb and avatar.usdz, the photos, overlays, previews, landmarks.json, the character, fit.json.
 #include "booth/session_folder.h"
+
+#include "booth/usdz.h"
 
 #include "common/atomic_output.h"
 #include "common/file_bytes.h"
@@ -109,6 +111,8 @@ std::vector<fs::path> writeSessionFolder(const FitOutcome& o, const SessionFolde
     };
     const auto t0 = Clock::now();
     put("avatar.glb", encodeGlb(o.fit.mesh, o.texture.texture, "avatar"));
+    // The same avatar for iOS's AR Quick Look (the visitor's page offers both: booth/usdz.h).
+    put("avatar.usdz", encodeUsdz(o.fit.mesh, o.texture.texture));
     // The photos themselves, as taken (personal data: the files are readable by the booth's user only).
     photo("front", contents.photoFiles.front, o.front);
     photo("side", contents.photoFiles.side, o.side);
@@ -122,6 +126,12 @@ std::vector<fs::path> writeSessionFolder(const FitOutcome& o, const SessionFolde
     put("preview_front.png", encodeImage(previews.front, ".png"));
     put("preview_side.png", encodeImage(previews.side, ".png"));
     put("preview_three_quarter.png", encodeImage(previews.threeQuarter, ".png"));
+    // The character's picture too, for the printed card (print/card.h), which is made from the session alone.
+    if (contents.character) {
+        renderer.upload(contents.character->head.mesh, contents.character->head.texture);
+        put("preview_character.png", encodeImage(renderThreeQuarterPreview(renderer, contents.character->head.mesh,
+                                                                           contents.previewSize), ".png"));
+    }
     const double previewSeconds = secondsSince(t1);
 
     put("landmarks.json", landmarksJson(o).dump(2) + "\n");

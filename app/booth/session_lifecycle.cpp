@@ -158,7 +158,7 @@ void SessionLifecycle::keepDone(const KeepDone& e, std::vector<Command>& out) {
         return;
     }
     spdlog::info("session kept as {}", e.code);
-    out.push_back(TellFlow{SessionSaved{e.code, e.t}});
+    out.push_back(TellFlow{SessionSaved{e.code, e.t, e.shareUrl}});
     if (!styleExtras_ || e.job != styleJob_) return;
     if (stylesSettled_) out.push_back(WriteStyleExtras{e.keptFolder});
     else extrasFor_ = e.keptFolder;  // its extras follow once drawn

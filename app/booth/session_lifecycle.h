@@ -65,6 +65,7 @@ struct KeepDone {
     std::filesystem::path keptFolder;
     std::string error;
     FlowTime t;
+    std::string shareUrl{};  // the kept session's page when sharing is on (booth/share_link.h)
 };
 // The visitor's session is over without a keep (the flow's DiscardSession), or the run ends.
 struct DiscardAsked {};

@@ -1,6 +1,8 @@
 // Kept sessions: short codes, keep/discard, retention (see session_store.h for the layout and the rules).
 #include "booth/session_store.h"
 
+#include "booth/share_link.h"
+
 #include "common/atomic_output.h"
 #include "common/error.h"
 
@@ -145,7 +147,9 @@ std::string SessionStore::keep(const fs::path& fitFolder, WallTime now) {
         if (attempt > 1000) failOutput(settings_.directory, "no free session code after 1000 attempts");
     }
     const auto keptSeconds = std::chrono::duration_cast<std::chrono::seconds>(now.time_since_epoch()).count();
-    nlohmann::json info{{"code", code}, {"kept_at", keptSeconds}};
+    // The visitor's page key (booth/share_link.h), drawn for every kept session: it is what makes the page's URL
+    // unguessable whether or not sharing is on now (the operator may turn it on later).
+    nlohmann::json info{{"code", code}, {"kept_at", keptSeconds}, {"share_token", makeShareToken()}};
     writeFileAtomically(fitFolder / kSessionFile, info.dump(2) + "\n");
     restrictModes(fitFolder);
     // RENAME_NOREPLACE: two booths sharing a folder (or a code drawn twice) can never overwrite a session.

@@ -2,7 +2,8 @@
 // booth's user, and deleted again by the retention rules (photos first, the avatar later).
 //
 // Layout under SessionStoreSettings::directory:
-//   <CODE>/          a kept session: the session folder (booth/session_folder.h) plus session.json (code, kept_at)
+//   <CODE>/          a kept session: the session folder (booth/session_folder.h) plus session.json (code, kept_at,
+//                    share_token: the key to the visitor's page, booth/share_link.h)
 //   .pending/<id>/   a fit of the visitor at the booth, not kept yet (writeSessionFolder creates it atomically)
 //   .trash-<CODE>-*  a session being deleted (renamed first, so a crash never leaves half a session under a code)
 // Folders are 0700 and files 0600: the photos are personal data.

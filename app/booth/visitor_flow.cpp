@@ -169,6 +169,7 @@ std::vector<FlowCommand> VisitorFlow::handle(const FlowEvent& event) {
                    [&](const SessionSaved& e) {
                        if (state_ != State::Thanks) return;
                        screen_.code = e.code;
+                       screen_.shareUrl = e.shareUrl;
                        if (!thanksResultAt_) thanksResultAt_ = e.t;
                    },
                    [&](const SessionSaveFailed& e) {
@@ -367,6 +368,7 @@ void VisitorFlow::startSession(FlowTime t, std::vector<FlowCommand>& out) {
     haveFront_ = haveSide_ = false;
     banner_ = BannerKind::None;
     screen_.code.clear();
+    screen_.shareUrl.clear();
     screen_.progress = 0.0;
     screen_.fitStep.reset();
     toGuide(Photo::Front, t, out);

@@ -17,13 +17,18 @@
 #include "drivers/gpio/button_backends.h"
 #include "drivers/gpio/gpiod_lines.h"
 #include "fit/face/landmarks68.h"
+#include "batch/batch_report.h"
 #include "booth/screens/strings.h"
+#include "booth/share_link.h"
+#include "print/cups_queue.h"
+#include "drivers/sound/sound_player.h"
 
 #include <nlohmann/json.hpp>
 
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -44,7 +49,7 @@ constexpr const char* kInstalledConfig = "/etc/avatarbooth/booth.toml";
 enum class Status { Ok, Warn, Fail };
 
 struct CheckLine {
-    std::string what;  // "config", "camera", "gpio", "display", "landmarks", "strings", "sessions"
+    std::string what;  // "config", "camera", "gpio", "display", "landmarks", "strings", "sessions", "share"
     Status status = Status::Ok;
     std::string message;
     ErrorKind kind = ErrorKind::Internal;  // for the exit code of a FAIL
@@ -278,6 +283,75 @@ void checkSessions(const fs::path& dir, Report& report) {
     else report.ok("sessions", where + ": writable, " + freeText);
 }
 
+// The visitors' page service ([share], `avatarbooth share`): off (nothing listens), or where it listens, the URL the
+// QR codes carry, and whether what it needs is there (TLS files readable, the 3-D viewer installed).
+void checkShare(const ShareSettings& share, const SessionStoreSettings& sessions, Report& report) {
+    if (!share.enabled) {
+        report.ok("share", "off ([share] enabled = false): no QR code, nothing listens");
+        return;
+    }
+    std::string what = "on: avatarbooth-share listens on " + share.listen + (share.tlsCertificate.empty() ? " (http)" : " (https)") +
+                       ", QR codes link " + shareBaseUrl(share) + "/s/<token>";
+    const auto lifetime = sessions.sessionRetention.count() > 0 ? std::min(share.pageLifetime, sessions.sessionRetention)
+                                                                : share.pageLifetime;
+    what += ", pages live " + std::to_string(std::chrono::duration_cast<std::chrono::hours>(lifetime).count()) + " h";
+    what += std::string(", downloads ") + (share.offerDownloads ? "on" : "off") + ", photos " + (share.offerPhotos ? "on" : "off");
+    for (const fs::path& f : {share.tlsCertificate, share.tlsKey}) {
+        if (!f.empty() && ::access(f.c_str(), R_OK) != 0) {
+            report.fail("share", what + "; " + f.string() + " is not readable", ErrorKind::BadConfig);
+            return;
+        }
+    }
+    if (findModelViewer().empty()) {
+        report.warn("share", what + "; model-viewer is not installed: pages offer downloads without the 3-D view");
+        return;
+    }
+    report.ok("share", what);
+}
+
+// The printed card's queue ([print]): off, or what CUPS says of the queue (there? accepting? stopped, out of paper:
+// the printer-state-reasons). A queue that cannot take the card fails; the booth itself would go on without it.
+void checkPrint(const PrintSettings& print, Report& report) {
+    if (!print.enabled) {
+        report.ok("print", "off ([print] enabled = false): Keep prints nothing");
+        return;
+    }
+    const QueueState q = queryQueue(print.queue);
+    char card[96];
+    std::snprintf(card, sizeof card, "; card %gx%g mm at %d dpi, %d cop%s", print.widthMm, print.heightMm, print.dpi,
+                  print.copies, print.copies == 1 ? "y" : "ies");
+    const std::string what = "queue " + (q.queue.empty() ? std::string("(CUPS default)") : q.queue) + ": " + q.describe() + card;
+    if (!q.found() || !q.accepting || q.stopped) report.fail("print", what, ErrorKind::Device);
+    else if (q.problem()) report.warn("print", what);
+    else report.ok("print", what);
+}
+
+// The sounds ([sound]): off, or the sound cards ALSA finds and whether the sound theme's clips are there. Nothing
+// is opened (a running booth holds the device); without a card the booth is silent, which is worth a warning.
+void checkSound(const SoundSettings& sound, Report& report) {
+    if (!sound.enabled) {
+        report.ok("sound", "off ([sound] enabled = false)");
+        return;
+    }
+    const std::vector<std::string> cards = soundCards();
+    std::string what = "device " + sound.device + ", volume " + std::to_string(sound.volume) + "%; ";
+    if (cards.empty()) what += "no sound card found";
+    else {
+        what += "sound card";
+        for (const auto& c : cards) what += " " + c + ";";
+        what.pop_back();
+    }
+    for (const char* clip : {"camera-shutter.oga", "complete.oga"}) {
+        const fs::path file = fs::path(sound.themeDir) / clip;
+        if (!fs::exists(file)) {
+            report.warn("sound", what + "; " + file.string() + " is missing (sound-theme-freedesktop): silent");
+            return;
+        }
+    }
+    if (cards.empty() && sound.device == "default") report.warn("sound", what + ": the booth is silent");
+    else report.ok("sound", what);
+}
+
 }  // namespace
 
 void registerCheckCommand(CLI::App& app) {
@@ -300,6 +374,9 @@ void registerCheckCommand(CLI::App& app) {
         checkBaseHead(config.fit, report);
         checkStrings(config.screen.stringsFile, report);
         checkSessions(config.sessions.directory, report);
+        checkShare(config.share, config.sessions, report);
+        checkPrint(config.print, report);
+        checkSound(config.sound, report);
 
         std::optional<ErrorKind> firstFailure;
         int fails = 0, warns = 0;

@@ -21,6 +21,8 @@ void registerCheckCommand(CLI::App& app);
 void registerRetentionCommand(CLI::App& app);
 // `avatarbooth config`: prints the documented default configuration or its Markdown reference, or checks a file.
 void registerConfigCommand(CLI::App& app);
+// `avatarbooth share`: serves the visitors' own pages (the QR code on the thanks screen), until stopped.
+void registerShareCommand(CLI::App& app);
 // `avatarbooth bench`: per-stage fit times on one photo pair.
 void registerBenchCommand(CLI::App& app);
 // `avatarbooth toon`: a front + side photo pair to Kitamura's two-view toon head, as a turntable strip of PNGs.

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
     avatarbooth::registerCheckCommand(app);
     avatarbooth::registerRetentionCommand(app);
     avatarbooth::registerConfigCommand(app);
+    avatarbooth::registerShareCommand(app);
     app.parse_complete_callback([&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::warn); });
     try {
         app.parse(argc, argv);

@@ -11,10 +11,13 @@
 #include "reveal/animation/avatar_motion.h"
 #include "booth/guidance.h"
 #include "booth/session_store.h"
+#include "booth/share_link.h"
+#include "print/print_settings.h"
 #include "booth/visitor_flow.h"
 #include "drivers/camera/camera_settings.h"
 #include "drivers/display/display_settings.h"
 #include "drivers/gpio/gpio_settings.h"
+#include "drivers/sound/sound_settings.h"
 #include "fit/head/base_head.h"
 #include "reveal/character/character_head.h"
 #include "reveal/styles/style_settings.h"
@@ -58,6 +61,9 @@ struct BoothConfig {
     CharacterConfig character;      // [character]
     RevealSettings reveal;          // [reveal]
     StageSettings stage;            // [stage]
+    ShareSettings share;            // [share]
+    PrintSettings print;            // [print]
+    SoundSettings sound;            // [sound]
 };
 
 // Every mistake in a configuration file, in line order, each a BoothError(BadConfig) "FILE:LINE: key: what is

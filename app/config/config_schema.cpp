@@ -319,6 +319,29 @@ std::vector<ConfigTable> makeTables() {
                         "in every session when enabled."});
     t.push_back({.name = "reveal", .doc = "The avatar styles on the reveal and attract screens."});
     t.push_back({.name = "stage", .doc = "Kitamura's tile stage under the avatars on the attract and reveal screens."});
+    t.push_back({.name = "share",
+                 .doc = "The visitor's own page (`avatarbooth share`, off by default: nothing listens unless enabled): "
+                        "the thanks screen shows a QR code of the session's page, which shows the avatar turning, "
+                        "with AR and downloads. The README's \"Take it home\" section sets up the hotspot.",
+                 .check = [](const BoothConfig& c) -> std::optional<ConfigProblem> {
+                     const ShareSettings& s = c.share;
+                     if (s.tlsCertificate.empty() != s.tlsKey.empty())
+                         return ConfigProblem{s.tlsCertificate.empty() ? "tls_key" : "tls_certificate",
+                                              "give both tls_certificate and tls_key, or neither"};
+                     const auto retention = c.sessions.sessionRetention;
+                     if (s.enabled && retention.count() > 0 && s.pageLifetime > retention)
+                         return ConfigProblem{"page_lifetime_days",
+                                              "a page cannot outlive its session: longer than [sessions] "
+                                              "session_retention_days"};
+                     return std::nullopt;
+                 }});
+    t.push_back({.name = "print",
+                 .doc = "The printed card (off by default): Keep prints the visitor's three styles, the short code and "
+                        "the QR code of their page through a CUPS queue. The README's \"Take it home\" section sets up "
+                        "the printer."});
+    t.push_back({.name = "sound",
+                 .doc = "The booth's sounds: a beep on each number of the countdown, the shutter, a chime at the "
+                        "reveal. On when the booth has a sound card."});
     return t;
 }
 
@@ -576,6 +599,100 @@ void addStageKeys(std::vector<ConfigKey>& k) {
                        "The camera's elevation in degrees at the ordinary 3-D end of the sweep."));
 }
 
+void addShareKeys(std::vector<ConfigKey>& k) {
+    // [share]
+    k.push_back(flag("share", "enabled", FIELD(share.enabled),
+                     "Give every kept session its page and show its QR code on the thanks screen; `avatarbooth share` "
+                     "(avatarbooth-share.service) serves the pages."));
+    {
+        ConfigKey listen = text("share", "listen", FIELD(share.listen),
+                                "ADDRESS:PORT the page server listens on (an IPv6 address in brackets); the default "
+                                "is the booth's own NetworkManager hotspot.");
+        const auto store = listen.set;
+        listen.set = [store](BoothConfig& c, std::size_t i, const ConfigValue& v) {
+            if (!parseListenAddress(std::get<std::string>(v)))
+                throw ConfigValueRejected{"\"" + std::get<std::string>(v) + "\" is not ADDRESS:PORT (port 1-65535)"};
+            store(c, i, v);
+        };
+        k.push_back(std::move(listen));
+    }
+    {
+        ConfigKey base = text("share", "base_url", FIELD(share.baseUrl),
+                              "The URL phones reach the server by (in the QR code), e.g. \"http://booth.example\"; "
+                              "\"\" = http://LISTEN (https:// with a certificate).");
+        const auto store = base.set;
+        base.set = [store](BoothConfig& c, std::size_t i, const ConfigValue& v) {
+            const std::string& url = std::get<std::string>(v);
+            const bool scheme = url.rfind("http://", 0) == 0 || url.rfind("https://", 0) == 0;
+            if (!url.empty() && (!scheme || url.find_first_of(" \t\"<>?#") != std::string::npos))
+                throw ConfigValueRejected{"\"" + url + "\" is not an http:// or https:// URL without query"};
+            // The QR code gets denser with every character: a short URL scans from further away.
+            if (url.size() > 100) throw ConfigValueRejected{"longer than 100 characters (the QR code would be too dense)"};
+            store(c, i, v);
+        };
+        k.push_back(std::move(base));
+    }
+    k.push_back(age<std::ratio<86400>>("share", "page_lifetime_days", FIELD(share.pageLifetime), 0.04, 3650.0,
+                                       "A page answers this long after its session was kept (at most the session's "
+                                       "retention); afterwards it answers like an unknown page."));
+    k.push_back(flag("share", "downloads", FIELD(share.offerDownloads),
+                     "The page offers avatar.glb, avatar.usdz, the preview image and the turning picture (turntable.webp) for "
+                     "download."));
+    k.push_back(flag("share", "photos", FIELD(share.offerPhotos),
+                     "The page also offers the visitor's two photos while they are kept (personal data: only with "
+                     "the visitors' consent)."));
+    k.push_back(path("share", "tls_certificate", FIELD(share.tlsCertificate),
+                     "HTTPS: the operator's certificate (PEM, readable by the service); \"\" = plain HTTP."));
+    k.push_back(path("share", "tls_key", FIELD(share.tlsKey), "HTTPS: the certificate's private key (PEM)."));
+    k.push_back(integer("share", "workers", FIELD(share.workers), 1, 64,
+                        "Requests served at once; as many more connections wait, the rest wait in the kernel."));
+    k.push_back(seconds("share", "read_timeout_s", FIELD(share.readTimeout), 1.0, 60.0,
+                        "A connection silent for this long is closed (a slow or stalled client); whole seconds."));
+}
+
+void addPrintKeys(std::vector<ConfigKey>& k) {
+    // [print]
+    k.push_back(flag("print", "enabled", FIELD(print.enabled),
+                     "Keep prints a card of the session (its styles, code and QR code) on the CUPS queue."));
+    {
+        ConfigKey queue = text("print", "queue", FIELD(print.queue),
+                               "The CUPS queue (`lpstat -p` lists them); \"\" = the CUPS server's default queue.");
+        const auto store = queue.set;
+        queue.set = [store](BoothConfig& c, std::size_t i, const ConfigValue& v) {
+            const std::string& name = std::get<std::string>(v);
+            // CUPS refuses these in a queue's name (lpadmin(8)); a typo is caught here rather than at the first keep.
+            if (name.find_first_of(" \t/#\\\"'") != std::string::npos || name.size() > 127)
+                throw ConfigValueRejected{"\"" + name + "\" is not a CUPS queue name (no spaces, /, # or quotes)"};
+            store(c, i, v);
+        };
+        k.push_back(std::move(queue));
+    }
+    k.push_back(number("print", "width_mm", FIELD(print.widthMm), 50.0, 300.0,
+                       "The card's width in millimetres (100 x 148: the postcard photo printers take)."));
+    k.push_back(number("print", "height_mm", FIELD(print.heightMm), 50.0, 300.0, "The card's height in millimetres."));
+    k.push_back(integer("print", "dpi", FIELD(print.dpi), 72, 1200,
+                        "The resolution the card's pictures are placed at (text and the QR code are vectors)."));
+    k.push_back(text("print", "media", FIELD(print.media),
+                     "The printer's own name for the paper (\"Postcard\", \"w284h420\"; `lpoptions -p QUEUE -l` lists "
+                     "them); \"\" = the card's size as a custom size (\"Custom.100x148mm\")."));
+    k.push_back(flag("print", "front_photo", FIELD(print.frontPhoto),
+                     "The visitor's front photo on the card too (personal data on paper)."));
+    k.push_back(text("print", "title", FIELD(print.title), "The line across the card's top (\"\" = none)."));
+    k.push_back(integer("print", "copies", FIELD(print.copies), 1, 10, "Cards printed per kept session."));
+}
+
+void addSoundKeys(std::vector<ConfigKey>& k) {
+    // [sound]
+    k.push_back(flag("sound", "enabled", FIELD(sound.enabled),
+                     "Sounds when the booth has a sound card (false: silent whatever it has)."));
+    k.push_back(integer("sound", "volume", FIELD(sound.volume), 0, 100,
+                        "Loudness of the booth's sounds, percent of their own level (the card's mixer is left as "
+                        "it is: set it once with alsamixer)."));
+    k.push_back(text("sound", "device", FIELD(sound.device),
+                     "The ALSA output (`aplay -L` lists them): \"default\" (the first sound card), \"hw:1\", ...; "
+                     "\"file:FILE=/tmp/booth.wav,FORMAT=wav\" records the sounds instead."));
+}
+
 std::vector<ConfigKey> makeKeys() {
     std::vector<ConfigKey> k;
     addFitKeys(k);
@@ -590,6 +707,9 @@ std::vector<ConfigKey> makeKeys() {
     addCharacterKeys(k);
     addRevealKeys(k);
     addStageKeys(k);
+    addShareKeys(k);
+    addPrintKeys(k);
+    addSoundKeys(k);
     return k;
 }
 

@@ -4,6 +4,7 @@
 
 #include "booth/session_lifecycle.h"
 #include "booth/session_store.h"
+#include "booth/share_link.h"
 #include "booth/visitor_flow.h"
 #include "booth/screens/screens.h"
 #include "common/error.h"
@@ -12,13 +13,16 @@
 #include "drivers/display/headless_egl.h"
 #include "common/clock.h"
 #include "drivers/gpio/lamps.h"
+#include "kiosk/booth_sounds.h"
 #include "kiosk/fit_worker.h"
 #include "kiosk/kiosk_figures.h"
 #include "kiosk/kiosk_inputs.h"
 #include "kiosk/preview_worker.h"
+#include "kiosk/print_worker.h"
 #include "kiosk/screenshots.h"
 #include "kiosk/session_writer.h"
 #include "kiosk/style_worker.h"
+#include "kiosk/turntable_worker.h"
 #include "kiosk/watchdog.h"
 #include "reveal/character/character_outputs.h"
 #include "reveal/styles/reveal_styles.h"
@@ -136,6 +140,9 @@ private:
     HeadlessEglContext offscreen_;
     RevealStyles styles_;
     StyleWorker styleWorker_;  // after the styles: its work posts to them, it ends first
+    std::optional<PrintWorker> printer_;  // [print] on: each kept session's card
+    std::unique_ptr<BoothSounds> sounds_;  // null: silent ([sound] off, no sound card)
+    std::optional<TurntableWorker> turntables_;  // [share] on: each kept session's turntable.webp
     std::optional<WatchdogPinger> watchdog_;  // from READY on
 
     // The visitor.
@@ -152,6 +159,12 @@ private:
     Hint lastHint_ = Hint::None;
     RetentionReport lastRetention_, lastFreed_;  // the last retention run, and the operator's last "free disk"
     int leftoversRemoved_ = 0;                   // by the last RemoveLeftovers
+    // The printer: its last news for the operator menu, and a kept session whose card waits for its toon strip
+    // (the card shows the toon: printed once the strip is written, or without it when the toon never comes).
+    std::string printerNews_;
+    bool printerProblem_ = false;
+    std::optional<PrintCard> cardAfterExtras_;
+    void printCard(PrintCard card);
     Screenshots screenshots_;
     KioskFigures figures_;
     bool ready_ = false;
@@ -185,6 +198,17 @@ Kiosk::Kiosk(const BoothConfig& config, const KioskOptions& options, SteadyClock
     note("buttons: " + board_.description);
     note("sessions: " + config.sessions.directory.string());
     report_.sessionsDirectory = config.sessions.directory;
+    {
+        std::string said;
+        sounds_ = BoothSounds::open(config.sound, said);
+        note("sound: " + said);
+    }
+    if (config.share.enabled) turntables_.emplace(queue_);
+    if (config.print.enabled) {
+        printer_.emplace(config.print, queue_);
+        printerNews_ = "on, queue " + (config.print.queue.empty() ? std::string("(CUPS default)") : config.print.queue);
+        note("print: " + printerNews_);
+    }
     startupStep("devices, workers and styles made");
     commands_ = flow_.initialCommands();
 }
@@ -209,6 +233,7 @@ KioskReport Kiosk::run() {
         runSession(lifecycle_.handle(session::TimePassed{std::chrono::steady_clock::now()}), now);
         step.mark("fit");
         runFlow(now);
+        if (sounds_) sounds_->screen(flow_.screen(), now);  // as of this loop step, when the screen changed
         lamps_.update(clock_.now());
         step.mark("flow");
 
@@ -327,6 +352,20 @@ void Kiosk::handle(const KioskMessage& message, FlowTime now) {
                 figures_.analysed(flow_.screen().id);
             } else if constexpr (std::is_same_v<T, StyleWorkEnded>) {
                 m.apply();
+            } else if constexpr (std::is_same_v<T, PrintStatus>) {
+                // The booth goes on whatever the printer says: the operator sees it in the menu and the log.
+                if (m.problem) spdlog::warn("print: {}", m.line);
+                else spdlog::info("print: {}", m.line);
+                printerNews_ = m.line;
+                printerProblem_ = m.problem;
+            } else if constexpr (std::is_same_v<T, TurntableEnded>) {
+                if (m.error)
+                    spdlog::warn("the kept session {} goes without its turntable picture: {}",
+                                 m.keptFolder.filename().string(), *m.error);
+                else
+                    spdlog::info("turntable.webp added to the kept session {}: {} KB, rendered in {:.2f} s, encoded in "
+                                 "{:.2f} s", m.keptFolder.filename().string(), m.bytes / 1024, m.renderSeconds,
+                                 m.encodeSeconds);
             } else if constexpr (std::is_same_v<T, FolderEnded>) {
                 if (m.error) spdlog::error("the session folder was not written: {}", m.error->what());
                 else spdlog::info("session folder written in {:.2f} s", m.seconds);
@@ -413,10 +452,24 @@ void Kiosk::runSession(const std::vector<session::Command>& commands, FlowTime n
                     try {
                         done.code = store_.keep(c.folder, std::chrono::system_clock::now());
                         if (const auto kept = store_.find(done.code)) done.keptFolder = *kept;
+                        // The visitor's page, for the QR code on the thanks screen (only when sharing is on).
+                        if (config_.share.enabled)
+                            if (const auto token = readShareToken(done.keptFolder))
+                                done.shareUrl = sharePageUrl(config_.share, *token);
                     } catch (const BoothError& e) {
                         done.error = e.what();
                     }
+                    // Keep prints when printing is on: once the toon strip is in the session (WriteStyleExtras,
+                    // perhaps run by this very handle()), or now when no strip is coming.
+                    if (printer_ && done.error.empty()) {
+                        // An earlier visitor's card still waiting for its toon goes now, without it.
+                        if (cardAfterExtras_) printCard(*std::exchange(cardAfterExtras_, {}));
+                        cardAfterExtras_ = PrintCard{done.keptFolder, done.code, done.shareUrl};
+                    }
+                    // The visitor's page gets its turntable picture, made behind the thanks screen.
+                    if (turntables_ && done.error.empty()) turntables_->submit(done.keptFolder);
                     runSession(lifecycle_.handle(done), now);
+                    if (cardAfterExtras_ && !lifecycle_.styleExtrasAwaited()) printCard(*std::exchange(cardAfterExtras_, {}));
                 } else if constexpr (std::is_same_v<T, session::DiscardFolder>) {
                     try {
                         store_.discard(c.folder);
@@ -431,6 +484,8 @@ void Kiosk::runSession(const std::vector<session::Command>& commands, FlowTime n
                         spdlog::error("the kept session {} goes without its toon strip: {}",
                                       c.keptFolder.filename().string(), e.what());
                     }
+                    if (cardAfterExtras_ && cardAfterExtras_->keptFolder == c.keptFolder)
+                        printCard(*std::exchange(cardAfterExtras_, {}));
                 } else if constexpr (std::is_same_v<T, session::TellFlow>) {
                     if (const auto* saved = std::get_if<SessionSaved>(&c.event)) {
                         ++report_.sessionsKept;
@@ -512,6 +567,8 @@ const cv::Mat& Kiosk::drawScreen(const ScreenModel& screen, KioskFigures::Frame&
         inputs.operatorInfo.sessionsStored = static_cast<int>(stored.size());
         inputs.operatorInfo.freeBytes = store_.freeBytes();
         inputs.operatorInfo.lastFreed = lastFreed_;
+        inputs.operatorInfo.printer = printerNews_;
+        inputs.operatorInfo.printerProblem = printerProblem_;
     }
     const cv::Mat& drawn = screens_.draw(screen, inputs);
     timing.composeEnd = std::chrono::steady_clock::now();
@@ -555,7 +612,19 @@ void Kiosk::finish() {
     if (lifecycle_.styleExtrasAwaited() && styles_.settled())
         runSession(lifecycle_.handle(session::StylesSettled{}), FlowClock::now());
     if (lifecycle_.styleExtrasAwaited()) spdlog::warn("a kept session goes without its toon strip: still drawing at the end");
+    // A card still waiting for its toon is printed without it; cards are sent before the booth ends (a run of N
+    // sessions; a stop does not wait for CUPS longer than its requests' own limits).
+    if (cardAfterExtras_) printCard(*std::exchange(cardAfterExtras_, {}));
+    if (turntables_ && !stopped) turntables_->waitIdle();
+    if (printer_ && !printer_->waitSent(std::chrono::seconds(stopped ? 5 : 30)))
+        spdlog::warn("print: a card was still being sent at the end");
+    waitForMessages(std::chrono::steady_clock::now());
     report_.screenshots = screenshots_.written();
+}
+
+void Kiosk::printCard(PrintCard card) {
+    spdlog::info("print: card {} queued", card.code);
+    printer_->print(std::move(card));
 }
 
 }  // namespace

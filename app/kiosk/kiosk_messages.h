@@ -57,8 +57,23 @@ struct StyleWorkEnded {
     std::function<void()> apply;
 };
 
+// The printer's news (PrintWorker): a card sent, a job's or the queue's new state; `problem` when the operator has
+// to act (out of paper, stopped, a job held or failed).
+struct PrintStatus {
+    std::string line;
+    bool problem = false;
+};
+
+// A kept session's turntable.webp was made (TurntableWorker), or not (`error`).
+struct TurntableEnded {
+    std::filesystem::path keptFolder;
+    std::size_t bytes = 0;
+    double renderSeconds = 0, encodeSeconds = 0;
+    std::optional<std::string> error;
+};
+
 using KioskMessage = std::variant<ModelLoaded, FitStepStarted, FitEnded, CharacterEnded, PreviewEnded, FolderEnded,
-                                  StyleWorkEnded>;
+                                  StyleWorkEnded, PrintStatus, TurntableEnded>;
 using KioskQueue = MessageQueue<KioskMessage>;
 
 }  // namespace avatarbooth

@@ -43,9 +43,13 @@ RenderCamera framedCamera(const Mesh& mesh, glm::dvec3 direction, glm::dvec3 up,
     return camera;
 }
 
-}  // namespace
+glm::dvec3 threeQuarterDirection() {
+    const double elevation = glm::radians(15.0);
+    return {-std::sin(glm::radians(45.0)) * std::cos(elevation), std::sin(elevation),
+            std::cos(glm::radians(45.0)) * std::cos(elevation)};
+}
 
-PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size) {
+void checkUploaded(const MeshRenderer& renderer, const Mesh& mesh, int size) {
     if (mesh.positions.empty() || mesh.triangles.empty())
         throw BoothError(ErrorKind::Internal, "", "previews: the mesh is empty");
     if (renderer.vertexCount() != mesh.positions.size() || renderer.triangleCount() != mesh.triangles.size())
@@ -56,16 +60,45 @@ PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size) {
                              std::to_string(renderer.vertexCount()) + " and " +
                              std::to_string(renderer.triangleCount()) + ")");
     if (size <= 0) throw BoothError(ErrorKind::Internal, "", "previews: size must be positive");
+}
 
+}  // namespace
+
+PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size) {
+    checkUploaded(renderer, mesh, size);
     const glm::dvec3 up(0.0, 1.0, 0.0);
-    const double elevation = glm::radians(15.0);
-    const glm::dvec3 threeQuarter(-std::sin(glm::radians(45.0)) * std::cos(elevation), std::sin(elevation),
-                                  std::cos(glm::radians(45.0)) * std::cos(elevation));
     PreviewSet set;
     set.front = renderer.render(framedCamera(mesh, {0.0, 0.0, 1.0}, up, size)).bgr;
     set.side = renderer.render(framedCamera(mesh, {-1.0, 0.0, 0.0}, up, size)).bgr;
-    set.threeQuarter = renderer.render(framedCamera(mesh, threeQuarter, up, size)).bgr;
+    set.threeQuarter = renderer.render(framedCamera(mesh, threeQuarterDirection(), up, size)).bgr;
     return set;
+}
+
+std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames) {
+    checkUploaded(renderer, mesh, size);
+    glm::dvec3 lo, hi;
+    mesh.bounds(lo, hi);
+    const glm::dvec3 centre = (lo + hi) * 0.5;
+    double radius = 1.0;
+    for (const auto& p : mesh.positions) radius = std::max(radius, glm::length(p - centre));
+    const double mmPerPixel = 2.0 * radius * (1.0 + 2.0 * kMargin) / size;
+    const double elevation = glm::radians(10.0);
+    std::vector<cv::Mat> out;
+    for (int i = 0; i < frames; ++i) {
+        const double a = 2.0 * 3.14159265358979323846 * i / frames;
+        const glm::dvec3 back(-std::sin(a) * std::cos(elevation), std::sin(elevation), std::cos(a) * std::cos(elevation));
+        RenderCamera camera = RenderCamera::orthographic(centre + back * (2.0 * radius + 100.0), centre,
+                                                         {0.0, 1.0, 0.0}, mmPerPixel, size, size);
+        camera.background = kBackground;
+        camera.lit = true;
+        out.push_back(renderer.render(camera).bgr);
+    }
+    return out;
+}
+
+cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size) {
+    checkUploaded(renderer, mesh, size);
+    return renderer.render(framedCamera(mesh, threeQuarterDirection(), {0.0, 1.0, 0.0}, size)).bgr;
 }
 
 }  // namespace avatarbooth

@@ -6,6 +6,8 @@
 
 #include <opencv2/core.hpp>
 
+#include <vector>
+
 namespace avatarbooth {
 
 struct PreviewSet {
@@ -19,5 +21,15 @@ struct PreviewSet {
 // `renderer` (with its texture); it is used for framing. Throws BoothError(Internal) when it is empty or is not
 // the uploaded one.
 PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size = 512);
+
+// The three-quarter view alone (the same picture as PreviewSet::threeQuarter), for a second mesh such as the
+// character: the same checks.
+cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size = 512);
+
+// `frames` views of the mesh turning once about its vertical axis (the first from the front, then towards the
+// subject's left), seen from slightly above, all at one scale (the mesh's bounding sphere fills the square, so the
+// head neither grows nor shrinks as it turns): lit, square (size x size, BGR), on the previews' grey. The same
+// checks as renderPreviews.
+std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames);
 
 }  // namespace avatarbooth

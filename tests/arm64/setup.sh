@@ -28,6 +28,8 @@ sysroot_packages=(
   libegl-dev libgles-dev libopengl-dev libgbm-dev libdrm-dev libx11-dev
   libcli11-dev libspdlog-dev libtomlplusplus-dev libsystemd-dev libgpiod-dev libcamera-dev
   libfreetype-dev libpng-dev libexif-dev libstb-dev zlib1g-dev
+  libqrencode-dev libcpp-httplib-dev libwebp-dev
+  libcairo2-dev libcups2-dev libasound2-dev libvorbis-dev libsamplerate0-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

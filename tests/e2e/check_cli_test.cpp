@@ -49,15 +49,62 @@ TEST(CheckCli, SimulatedBoothIsReady) {
     const nlohmann::json report = nlohmann::json::parse(json.output);
     EXPECT_TRUE(report.at("ok").get<bool>());
     EXPECT_EQ(report.at("failures").get<int>(), 0);
-    for (const char* check : {"config", "gpio", "display", "landmarks", "strings", "sessions"}) {
+    for (const char* check : {"config", "gpio", "display", "landmarks", "strings", "sessions", "share", "print"}) {
         const auto s = statusesOf(report, check);
         ASSERT_FALSE(s.empty()) << check;
         EXPECT_EQ(s.back(), "OK") << check << ": " << messagesOf(report, check);
     }
     EXPECT_NE(messagesOf(report, "sessions").find("MB free"), std::string::npos);
+    EXPECT_EQ(messagesOf(report, "share").rfind("off ([share] enabled = false)", 0), 0u) << messagesOf(report, "share");
+    EXPECT_EQ(messagesOf(report, "print").rfind("off ([print] enabled = false)", 0), 0u) << messagesOf(report, "print");
+    // The sound card: this machine has none (a container) or some; either way the check says which.
+    const std::string sound = messagesOf(report, "sound");
+    EXPECT_NE(sound.find("device default, volume 80%; "), std::string::npos) << sound;
+    EXPECT_TRUE(sound.find("no sound card found") != std::string::npos || sound.find("sound card 0: ") != std::string::npos)
+        << sound;
     EXPECT_NE(messagesOf(report, "landmarks").find("loads"), std::string::npos);
     // The sim camera is OK whatever real cameras this machine has.
     EXPECT_EQ(statusesOf(report, "camera").back(), "OK");
+}
+
+// The visitors' page service, on: where it listens and what the QR codes link; a TLS key it cannot read fails.
+TEST(CheckCli, ShareServiceIsReported) {
+    const fs::path dir = scratchDir("check_share");
+    const fs::path config = dir / "booth.toml";
+    std::ofstream(config) << "[camera]\nbackend = \"sim\"\n[buttons]\nbackend = \"sim\"\n[display]\nbackend = \"headless\"\n"
+                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n"
+                          << "[share]\nenabled = true\nlisten = \"10.42.0.1:8080\"\n";
+    fs::create_directories(dir / "sessions");
+    const CommandResult on = run("check --json --config " + config.string(), dir);
+    const nlohmann::json report = nlohmann::json::parse(on.output);
+    EXPECT_EQ(messagesOf(report, "share").rfind("on: avatarbooth-share listens on 10.42.0.1:8080 (http), QR codes link "
+                                                "http://10.42.0.1:8080/s/<token>, pages live 168 h",
+                                                0),
+              0u)
+        << messagesOf(report, "share");
+    std::ofstream(config, std::ios::app) << "tls_certificate = \"" << (dir / "none.pem").string() << "\"\n"
+                                         << "tls_key = \"" << (dir / "none.key").string() << "\"\n";
+    const CommandResult tls = run("check --json --config " + config.string(), dir);
+    EXPECT_EQ(tls.exitCode, 6) << tls.output;
+    const nlohmann::json failed = nlohmann::json::parse(tls.output);
+    EXPECT_EQ(statusesOf(failed, "share").back(), "FAIL");
+    EXPECT_NE(messagesOf(failed, "share").find("none.pem is not readable"), std::string::npos) << messagesOf(failed, "share");
+}
+
+// Printing on with no CUPS scheduler to ask: the print queue FAILs, saying so, at once (a live queue's states are
+// checked against a real cupsd in tests/integration/print_card_test.cpp).
+TEST(CheckCli, PrintQueueWithoutCupsFails) {
+    const fs::path dir = scratchDir("check_print");
+    const fs::path config = dir / "booth.toml";
+    std::ofstream(config) << "[print]\nenabled = true\nqueue = \"photo\"\n";
+    setenv("CUPS_SERVER", (dir / "no-cupsd.sock").c_str(), 1);  // whatever this machine runs
+    const CommandResult json = run("check --json --config " + config.string(), dir);
+    unsetenv("CUPS_SERVER");
+    const nlohmann::json report = nlohmann::json::parse(json.output);
+    EXPECT_NE(json.exitCode, 0);
+    EXPECT_EQ(statusesOf(report, "print"), std::vector<std::string>{"FAIL"}) << messagesOf(report, "print");
+    EXPECT_NE(messagesOf(report, "print").find("queue photo: no CUPS scheduler"), std::string::npos)
+        << messagesOf(report, "print");
 }
 
 TEST(CheckCli, MissingHardwareTheConfigAsksForFails) {

@@ -64,7 +64,9 @@ TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
     EXPECT_EQ(field(info, "Package"), "avatarbooth");
     const std::string depends = field(info, "Depends");
     for (const char* p : {"libdlib-data", "libopencv-core", "libdlib19", "libgpiod2", "libcamera", "libsystemd0",
-                          "fonts-dejavu-core", "systemd"})
+                          "fonts-dejavu-core", "systemd", "libqrencode4", "libcpp-httplib0.11", "libcairo2", "libcups2",
+                          "libasound2", "libvorbisfile3", "libsamplerate0", "sound-theme-freedesktop",
+                          "libwebpmux3"})
         EXPECT_NE(depends.find(p), std::string::npos) << p << " not in Depends: " << depends;
     EXPECT_NE(info.find(" postinst "), std::string::npos) << info;
     EXPECT_NE(info.find(" conffiles "), std::string::npos) << info;
@@ -83,7 +85,8 @@ TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
     for (const char* path : {"./usr/bin/avatarbooth", "./etc/avatarbooth/booth.toml", "./usr/share/avatarbooth/strings.toml",
                              "./usr/lib/systemd/system/avatarbooth.service",
                              "./usr/lib/systemd/system/avatarbooth-retention.service",
-                             "./usr/lib/systemd/system/avatarbooth-retention.timer", "./usr/lib/tmpfiles.d/avatarbooth.conf",
+                             "./usr/lib/systemd/system/avatarbooth-retention.timer",
+                             "./usr/lib/systemd/system/avatarbooth-share.service", "./usr/lib/tmpfiles.d/avatarbooth.conf",
                              "./usr/lib/sysusers.d/avatarbooth.conf", "./usr/lib/udev/rules.d/60-avatarbooth.rules",
                              "./usr/share/avatarbooth/firmware/avatarbooth-overlay.dts",
                              "./usr/share/avatarbooth/firmware/config.txt.fragment",

@@ -18,7 +18,7 @@ while (($#)); do
     *) echo "usage: $0 [--seconds N] [--build-dir DIR] [--target NAME]..." >&2; exit 2 ;;
   esac
 done
-((${#targets[@]})) || targets=(fuzz_photo fuzz_session_folder fuzz_config fuzz_manifest)
+((${#targets[@]})) || targets=(fuzz_photo fuzz_session_folder fuzz_config fuzz_manifest fuzz_share_request)
 
 if ! command -v clang++-14 >/dev/null || [ ! -e /usr/lib/llvm-14/lib/clang/14.0.6/lib/linux/libclang_rt.fuzzer-x86_64.a ] &&
    ! ls /usr/lib/llvm-14/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then

@@ -75,7 +75,8 @@ TEST(ApplianceSystemd, EveryUnitVerifies) {
     requireTool("systemd-analyze", "systemd");
     const fs::path dir = scratchDir("appliance_verify");
     std::string units;
-    for (const char* name : {"avatarbooth.service", "avatarbooth-retention.service", "avatarbooth-retention.timer"})
+    for (const char* name : {"avatarbooth.service", "avatarbooth-retention.service", "avatarbooth-retention.timer",
+                             "avatarbooth-share.service"})
         units += " " + unitForVerify(dir, name).string();
     const CommandResult r = shell("systemd-analyze verify" + units);
     EXPECT_EQ(r.exitCode, 0) << r.output;
@@ -98,10 +99,29 @@ TEST(ApplianceSystemd, ServiceUnitIsNotifyWithWatchdogAndRestart) {
     EXPECT_LE(std::stoi(m[1]), 60);
 }
 
+// The share service (issue 23): off unless enabled, not restarted when booth.toml says sharing is off (exit 6), and
+// sandboxed to reading the sessions folder and listening on the web ports.
+TEST(ApplianceSystemd, ShareUnitMayOnlyReadTheSessionsAndListen) {
+    const std::string unit = readText(kSource / "systemd/avatarbooth-share.service");
+    EXPECT_NE(unit.find("\nExecStart=/usr/bin/avatarbooth share --config /etc/avatarbooth/booth.toml\n"), std::string::npos);
+    EXPECT_NE(unit.find("\nType=notify\n"), std::string::npos);
+    EXPECT_NE(unit.find("\nRestartPreventExitStatus=6\n"), std::string::npos);
+    EXPECT_NE(unit.find("\nUser=avatarbooth\n"), std::string::npos);
+    EXPECT_NE(unit.find("\nProtectSystem=strict\n"), std::string::npos);
+    EXPECT_NE(unit.find("\nTemporaryFileSystem=/var:ro\n"), std::string::npos);
+    EXPECT_NE(unit.find("\nBindReadOnlyPaths=/var/lib/avatarbooth/sessions\n"), std::string::npos);
+    EXPECT_EQ(unit.find("StateDirectory="), std::string::npos) << "it writes nowhere";
+    EXPECT_EQ(unit.find("ReadWritePaths="), std::string::npos) << "it writes nowhere";
+    EXPECT_NE(unit.find("\nSocketBindDeny=any\n"), std::string::npos);
+    EXPECT_NE(unit.find("\nCapabilityBoundingSet=CAP_NET_BIND_SERVICE\n"), std::string::npos);
+    // The kiosk stays off the network.
+    EXPECT_NE(readText(kSource / "systemd/avatarbooth.service").find("\nPrivateNetwork=yes\n"), std::string::npos);
+}
+
 TEST(ApplianceSystemd, SecurityExposureAtMostTwo) {
     requireTool("systemd-analyze", "systemd");
     const fs::path dir = scratchDir("appliance_security");
-    for (const std::string name : {"avatarbooth.service", "avatarbooth-retention.service"}) {
+    for (const std::string name : {"avatarbooth.service", "avatarbooth-retention.service", "avatarbooth-share.service"}) {
         const fs::path unit = unitForVerify(dir, name);
         // --offline: judge the file itself, not a loaded unit (works in a container without a running systemd).
         const CommandResult r = shell("systemd-analyze security --offline=true --no-pager " + unit.string());

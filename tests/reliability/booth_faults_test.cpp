@@ -232,7 +232,7 @@ TEST(BoothFaults, DiskFullWhileTheSessionIsWritten) {
     std::optional<FlowTime> clearedAt;
     FaultyVisit visit([&](const ScreenModel& s, FlowTime now) {
         if (!injected && s.id == ScreenId::Processing) {
-            injectWriteFailure(2, ENOSPC);  // the glb and the front photo fit; the disk is full from the third file
+            injectWriteFailure(2, ENOSPC);  // the glb and the usdz fit; the disk is full from the third file (a photo)
             injected = true;
         }
         // Space is freed as soon as the booth has told the visitor: before the keep (the fit failed: photos again)

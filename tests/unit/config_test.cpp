@@ -234,6 +234,10 @@ TEST(Config, EveryKeyLandsInItsSetting) {
                               std::vector<std::string>{k.choices.front(), k.choices.back()}};
                 break;
         }
+        // Text keys whose words are checked: values of their shape.
+        if (key == "share.listen") candidates = {std::string("127.0.0.1:8080"), std::string("[::1]:443")};
+        if (key == "share.base_url") candidates = {std::string("https://booth.example")};
+        if (key == "print.queue") candidates = {std::string("Canon_SELPHY_CP1500")};
         // A repeated table's element needs its required keys; fit's base head needs both files.
         std::string head = "[" + k.table + "]\n";
         if (k.table == "buttons.button" || k.table == "buttons.lamp")
@@ -241,6 +245,8 @@ TEST(Config, EveryKeyLandsInItsSetting) {
         if (key == "fit.base_mesh") head += "base_features = \"f.json\"\n";
         if (key == "fit.base_features") head += "base_mesh = \"m.glb\"\n";
         if (key == "stage.map") head += "enabled = false\n";  // an enabled stage reads its map at once
+        if (key == "share.tls_certificate") head += "tls_key = \"k.pem\"\n";
+        if (key == "share.tls_key") head += "tls_certificate = \"c.pem\"\n";
         bool landed = false;
         std::string errors;
         for (const ConfigValue& v : candidates) {

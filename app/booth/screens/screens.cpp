@@ -1,6 +1,7 @@
 // Drawing each booth screen (see screens.h): layout bands, the mirrored preview with its oval, texts and labels.
 #include "booth/screens/screens.h"
 
+#include "booth/screens/qr_code.h"
 #include "common/error.h"
 
 #include <opencv2/imgproc.hpp>
@@ -125,6 +126,22 @@ ScreenRenderer::ScreenRenderer(ScreenSettings settings)
     const int codeW = std::min(W - 2 * margin, static_cast<int>(std::lround(620 * L.unit)));
     const cv::Rect codeRows = rows(0.40, 0.64);
     L.code = cv::Rect((W - codeW) / 2, codeRows.y, codeW, codeRows.height);
+    // With a QR code: the code in the left half and the QR code in the right half of the middle band (landscape),
+    // or the code under the title and the QR code under it (portrait). The QR code takes as much of the screen as
+    // the layout leaves it: to be scanned from 1 m a code should be about 10 cm wide (a tenth of the distance),
+    // which a 1280x720 panel of 15" (19 cm tall) gives at 0.52 of its height.
+    if (W >= H) {
+        const int side = std::min(L.middle.height, W / 2 - 2 * margin);
+        L.qr = cv::Rect(W / 2 + (W / 2 - side) / 2, L.middle.y + (L.middle.height - side) / 2, side, side);
+        const int w = std::min(W / 2 - 2 * margin, static_cast<int>(std::lround(560 * L.unit)));
+        L.codeBesideQr = cv::Rect(W / 4 - w / 2, codeRows.y, w, codeRows.height);
+    } else {
+        const cv::Rect codeBand = rows(0.24, 0.34);
+        L.codeBesideQr = cv::Rect((W - codeW) / 2, codeBand.y, codeW, codeBand.height);
+        const int top = static_cast<int>(std::lround(0.37 * H));
+        const int side = std::min(W - 2 * margin, L.bottom.y - top - margin);
+        L.qr = cv::Rect((W - side) / 2, top, side, side);
+    }
     const int barW = std::min(W - 2 * margin, static_cast<int>(std::lround(760 * L.unit)));
     const int barH = std::max(8, static_cast<int>(std::lround(26 * L.unit)));
     L.progress = cv::Rect((W - barW) / 2, static_cast<int>(std::lround(0.66 * H)), barW, barH);
@@ -595,15 +612,17 @@ void ScreenRenderer::thanks(const ScreenModel& m) {
     drawText(str("thanks.title"), L.top + cv::Point(0, static_cast<int>(20 * u)), static_cast<int>(68 * u), kAccent,
              FontWeight::Bold);
     if (m.code.empty() && m.banner == BannerKind::SaveFailed) return;  // no code to show; the banner says why
-    const cv::Rect label(L.middle.x, L.code.y - static_cast<int>(80 * u), L.middle.width, static_cast<int>(70 * u));
+    const bool withQr = !m.code.empty() && !m.shareUrl.empty();
+    const cv::Rect codeBox = withQr ? L.codeBesideQr : L.code;
+    const cv::Rect label(codeBox.x, codeBox.y - static_cast<int>(80 * u), codeBox.width, static_cast<int>(70 * u));
     drawText(str("thanks.code_label"), label, static_cast<int>(44 * u), kSoftWhite);
-    fillRounded(canvas_, L.code, static_cast<int>(28 * u), kSoftWhite);
+    fillRounded(canvas_, codeBox, static_cast<int>(28 * u), kSoftWhite);
     if (m.code.empty()) {
-        drawText(str("thanks.saving"), L.code, static_cast<int>(60 * u), kInk, FontWeight::Bold);
+        drawText(str("thanks.saving"), codeBox, static_cast<int>(60 * u), kInk, FontWeight::Bold);
     } else {
         // Letters spaced out a little: a code is read (and copied) one character at a time.
-        int px = static_cast<int>(L.code.height * 0.62);
-        const int inner = L.code.width - static_cast<int>(48 * u);
+        int px = static_cast<int>(codeBox.height * 0.62);
+        const int inner = codeBox.width - static_cast<int>(48 * u);
         if (widestCodeLetterAt_ != px) {
             int widestWidth = -1;
             for (char c : kCodeAlphabet) {
@@ -623,11 +642,37 @@ void ScreenRenderer::thanks(const ScreenModel& m) {
         // Sized so that the widest code of this length fits, so every code shows at one size (rather than one
         // size per code's width, which would also give the glyph cache a new size for most visitors).
         if (const int w = text_->measure(widest, px, FontWeight::Bold).width; w > inner) px = px * inner / w;
-        drawText(spaced, L.code, px, kInk, FontWeight::Bold);
+        drawText(spaced, codeBox, px, kInk, FontWeight::Bold);
     }
-    const cv::Rect info(L.middle.x + static_cast<int>(32 * u), L.code.br().y + static_cast<int>(24 * u),
-                        L.middle.width - static_cast<int>(64 * u), static_cast<int>(0.16 * canvas_.rows));
-    if (!m.code.empty()) drawText(str("thanks.instructions"), info, static_cast<int>(40 * u), kSoftWhite);
+    if (m.code.empty()) return;
+    if (!withQr) {
+        const cv::Rect info(L.middle.x + static_cast<int>(32 * u), L.code.br().y + static_cast<int>(24 * u),
+                            L.middle.width - static_cast<int>(64 * u), static_cast<int>(0.16 * canvas_.rows));
+        drawText(str("thanks.instructions"), info, static_cast<int>(40 * u), kSoftWhite);
+        return;
+    }
+    // The QR code: whole pixels per module, as large as L.qr allows, drawn once per session. (A URL no QR code
+    // holds cannot come from a checked configuration; the screen would then show the code alone.)
+    if (qrUrl_ != m.shareUrl) {
+        try {
+            const cv::Mat modules = encodeQrModules(m.shareUrl);
+            const int perModule = std::max(1, L.qr.width / (modules.cols + 2 * kQrQuietModules));
+            qrImage_ = drawQrCode(modules, perModule);
+        } catch (const BoothError&) {
+            qrImage_.release();
+        }
+        qrUrl_ = m.shareUrl;
+    }
+    if (qrImage_.empty()) return;
+    const cv::Rect at(L.qr.x + (L.qr.width - qrImage_.cols) / 2, L.qr.y + (L.qr.height - qrImage_.rows) / 2,
+                      qrImage_.cols, qrImage_.rows);
+    qrImage_.copyTo(canvas_(at & cv::Rect(0, 0, canvas_.cols, canvas_.rows)));
+    const bool landscape = canvas_.cols >= canvas_.rows;
+    const cv::Rect info = landscape ? cv::Rect(codeBox.x, codeBox.br().y + static_cast<int>(24 * u), codeBox.width,
+                                               L.middle.br().y - codeBox.br().y - static_cast<int>(24 * u))
+                                    : cv::Rect(L.middle.x + static_cast<int>(32 * u), at.br().y,
+                                               L.middle.width - static_cast<int>(64 * u), L.bottom.br().y - at.br().y);
+    if (info.height > 0) drawText(str("thanks.scan"), info, static_cast<int>(36 * u), kSoftWhite);
 }
 
 void ScreenRenderer::cameraLost(const ScreenModel& m) {
@@ -682,6 +727,10 @@ void ScreenRenderer::operatorMenu(const ScreenModel& m, const ScreenInputs& in) 
             drawText(s, {margin, y, W - 2 * margin, static_cast<int>(rowH * 0.7)}, static_cast<int>(30 * u), kGrey);
             y += static_cast<int>(rowH * 0.7);
         }
+        if (!info.printer.empty())
+            drawText(strings_.format(settings_.language, "operator.printer", {{"state", info.printer}}),
+                     {margin, y, W - 2 * margin, static_cast<int>(rowH * 0.7)}, static_cast<int>(30 * u),
+                     info.printerProblem ? kRetakeRed : kGrey);
         drawText(str("operator.help"), {0, H - static_cast<int>(80 * u), W, static_cast<int>(60 * u)},
                  static_cast<int>(30 * u), kSoftWhite);
         return;

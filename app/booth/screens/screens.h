@@ -46,6 +46,8 @@ struct OperatorInfo {
     int sessionsStored = 0;
     std::uintmax_t freeBytes = 0;
     RetentionReport lastFreed;  // what the last FreeDisk did
+    std::string printer;        // the printer's last news ([print] on; "" = printing off)
+    bool printerProblem = false;  // ... and whether the operator has to act on it (shown in red)
 };
 
 struct ScreenInputs {
@@ -70,6 +72,10 @@ struct ScreenLayout {
     cv::Rect bottom;    // hint, prompt, button labels
     cv::Rect leftLabel, rightLabel;  // the two button labels inside `bottom`
     cv::Rect code;      // the thanks screen's code box
+    // The thanks screen when sharing is on: the QR code of the visitor's page (the largest square that fits, quiet
+    // zone included) and the code box beside it (landscape) or above it (portrait).
+    cv::Rect qr;
+    cv::Rect codeBesideQr;
     cv::Rect progress;  // the processing screen's bar
     cv::Rect stage;     // attract and reveal: the band the tile stage fills, under the avatars
     double unit = 1.0;  // the text scale: shorter screen side / 720
@@ -155,6 +161,9 @@ private:
     };
     std::optional<RevealShown> revealShown_;
     cv::Mat outsideOval_;       // 255 outside the oval, for the last preview size
+    // The thanks screen's QR code, drawn once per URL (not every frame).
+    std::string qrUrl_;
+    cv::Mat qrImage_;
     cv::Size outsideOvalFor_;   // the preview size outsideOval_ was made for
 };
 

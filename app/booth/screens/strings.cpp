@@ -52,6 +52,7 @@ constexpr std::string_view kRequired[] = {
     "thanks.code_label",
     "thanks.instructions",
     "thanks.saving",
+    "thanks.scan",
     "error.camera_lost.title",
     "error.camera_lost.body",
     "error.capture_failed",
@@ -70,6 +71,7 @@ constexpr std::string_view kRequired[] = {
     "operator.sessions",
     "operator.free",
     "operator.freed",
+    "operator.printer",
     "operator.camera_ok",
     "operator.camera_lost",
 };

@@ -1,0 +1,55 @@
+// The kiosk's turntable maker (see turntable_worker.h).
+#include "kiosk/turntable_worker.h"
+
+#include "booth/animated_webp.h"
+#include "common/atomic_output.h"
+#include "fit/export/glb.h"
+#include "render/mesh_renderer.h"
+#include "render/previews.h"
+
+#include <chrono>
+
+namespace avatarbooth {
+
+namespace {
+double since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+}  // namespace
+
+TurntableEnded makeTurntable(const std::filesystem::path& keptFolder, const TurntableSpec& spec) {
+    TurntableEnded done{keptFolder, 0, 0.0, 0.0, std::nullopt};
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::filesystem::path glb = keptFolder / "avatar.glb";
+    const Mesh mesh = readGlbMesh(glb);
+    const cv::Mat texture = readGlbTexture(glb);
+    std::vector<cv::Mat> frames;
+    {
+        // A renderer of its own for the job (as the session writer's): its GL context and buffers go with it.
+        MeshRenderer renderer(MeshRendererOptions{.maxSamples = 2, .depth = false});
+        renderer.upload(mesh, texture);
+        frames = renderTurntable(renderer, mesh, spec.size, spec.frames);
+    }
+    done.renderSeconds = since(t0);
+    const auto t1 = std::chrono::steady_clock::now();
+    const std::string webp = encodeAnimatedWebp(frames, spec.frameMs, spec.quality);
+    writeFileAtomically(keptFolder / "turntable.webp", webp);
+    done.encodeSeconds = since(t1);
+    done.bytes = webp.size();
+    return done;
+}
+
+TurntableWorker::TurntableWorker(KioskQueue& queue, int niceness)
+    : queue_(queue), thread_(
+                         [this](std::filesystem::path& folder) {
+                             TurntableEnded done{folder, 0, 0.0, 0.0, std::nullopt};
+                             try {
+                                 done = makeTurntable(folder);
+                             } catch (const std::exception& e) {
+                                 done.error = e.what();
+                             }
+                             queue_.post(std::move(done));
+                         },
+                         niceness) {}
+
+}  // namespace avatarbooth
