@@ -4,6 +4,7 @@
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/file_bytes.h"
+#include "common/html_text.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,20 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string html(const std::string& text) {
-    std::string out;
-    for (const char c : text) {
-        switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            case '\'': out += "&#39;"; break;
-            default: out += c;
-        }
-    }
-    return out;
-}
+std::string html(const std::string& text) { return escapeHtml(text); }
 
 // A relative path as a URL path: each segment percent-encoded where needed (ids are plain, input names may not be).
 std::string url(const std::string& relative) {

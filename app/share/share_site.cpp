@@ -2,6 +2,7 @@
 #include "share/share_site.h"
 
 #include "common/error.h"
+#include "common/html_text.h"
 
 #include <nlohmann/json.hpp>
 #include <zlib.h>
@@ -68,20 +69,7 @@ std::optional<std::string> readSessionFile(const fs::path& p) {
     return out;
 }
 
-std::string html(const std::string& s) {
-    std::string out;
-    for (const char c : s) {
-        switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            case '\'': out += "&#39;"; break;
-            default: out += c;
-        }
-    }
-    return out;
-}
+std::string html(const std::string& text) { return escapeHtml(text); }
 
 std::string dayOf(WallTime t) {
     const std::time_t tt = std::chrono::system_clock::to_time_t(t);

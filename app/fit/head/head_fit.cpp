@@ -355,11 +355,13 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     const Mesh& s = fit.scaledBase;
 
     // --- Step 5: the RBF warps, (x, y) from the front and (z, y) from the side, merged.
-    // The landmarks give way by landmarkRidge; the outline rays are interpolated exactly.
+    // After the modifiers the warp takes a residual, and the landmarks give way by landmarkRidge; the outline rays
+    // are interpolated exactly. A base head without modifiers is warped as the paper does, through every point.
+    const double landmarkRidge = base.modifiers ? options.landmarkRidge : 0.0;
     const auto ridgeOf = [&](const ViewTargets& view) {
         std::vector<double> ridge;
         for (const auto& [name, target] : view.targets)
-            ridge.push_back(name.find("_contour_") != std::string::npos ? 0.0 : options.landmarkRidge);
+            ridge.push_back(name.find("_contour_") != std::string::npos ? 0.0 : landmarkRidge);
         return ridge;
     };
     const RbfWarp frontWarp(frontT.centres, frontT.displacements, options.rbf, ridgeOf(frontT));

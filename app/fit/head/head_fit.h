@@ -40,8 +40,8 @@ struct HeadFitOptions {
     // where along the curve the point lies is a convention, but not worthless (the ground truth's too).
     double outlineTangentWeight = 0.3;
     // Ridge of the warp for the landmarks (added to rbf.regularisation on their diagonal; the outline rays keep the
-    // exact interpolation): a detected landmark is a few pixels off, and the warp that passes through each one
-    // exactly carries that noise into the face the modifiers had already shaped.
+    // exact interpolation) when the base head has a modifier basis: a detected landmark is a few pixels off, and the
+    // warp that passes through each one exactly carries that noise into the face the modifiers had already shaped.
     double landmarkRidge = 3.0;
 };
 
