@@ -39,7 +39,9 @@ Ran run(const std::string& command, bool withErrors = true) {
 }
 bool have(const std::string& tool) { return run("command -v " + tool + " >/dev/null").status == 0; }
 
-// One cupsd of the test's own: its configuration, spool, logs and socket under `dir`, with a cups-pdf queue.
+// One cupsd of the test's own with a cups-pdf queue whose PDFs land in `out` (the test's scratch folder). The
+// scheduler's configuration, spool, logs and socket go to a fresh folder under /tmp (removed at the end): its
+// filters run as the lp user, who can reach /tmp but not necessarily the build tree.
 class CupsServer {
 public:
     static std::string missing() {
@@ -52,12 +54,15 @@ public:
         return {};
     }
 
-    explicit CupsServer(const fs::path& dir) : dir_(dir), queue_("avatarbooth-test-" + std::to_string(getpid())) {
-        for (const char* sub : {"spool", "tmp", "state", "cache", "logs", "out"}) fs::create_directories(dir / sub);
+    explicit CupsServer(const fs::path& out) : out_(out), queue_("avatarbooth-test-" + std::to_string(getpid())) {
+        char folder[] = "/tmp/avatarbooth-cups-XXXXXX";
+        if (!mkdtemp(folder)) return;
+        dir_ = folder;
+        const fs::path& dir = dir_;
+        fs::permissions(dir, fs::perms::owner_all | fs::perms::group_exec | fs::perms::others_exec);
+        fs::create_directories(out);
+        for (const char* sub : {"spool", "tmp", "state", "cache", "logs"}) fs::create_directories(dir / sub);
         fs::permissions(dir / "tmp", fs::perms::all | fs::perms::sticky_bit);
-        // cupsd drops to the lp user for filters: it must reach its own files.
-        for (fs::path p = dir; p != p.root_path(); p = p.parent_path())
-            fs::permissions(p, fs::perms::others_exec | fs::perms::group_exec, fs::perm_options::add);
         socket_ = dir / "cups.sock";
         std::ofstream(dir / "cupsd.conf") << "Listen " << socket_.string() << "\nLogLevel info\nWebInterface No\n"
                                           << "Browsing No\nDefaultAuthType None\nMaxJobs 50\n"
@@ -74,7 +79,7 @@ public:
         // cups-pdf reads the configuration of the queue whose device URI is cups-pdf:/NAME from
         // /etc/cups/cups-pdf-NAME.conf (a path built into the backend): one file per test run, removed at the end.
         pdfConf_ = "/etc/cups/cups-pdf-" + queue_ + ".conf";
-        std::ofstream(pdfConf_) << "Out " << (dir / "out").string() << "\nAnonDirName " << (dir / "out").string()
+        std::ofstream(pdfConf_) << "Out " << out.string() << "\nAnonDirName " << out.string()
                                 << "\nLabel 0\nGrp root\nLog " << (dir / "logs").string() << "\n";
         pid_ = fork();
         if (pid_ == 0) {
@@ -95,21 +100,21 @@ public:
         }
         std::error_code ec;
         fs::remove(pdfConf_, ec);
+        if (!dir_.empty()) fs::remove_all(dir_, ec);
         unsetenv("CUPS_SERVER");
         cupsSetServer(nullptr);
     }
     bool ok() const { return ok_; }
     std::string log() const { return run("tail -20 '" + (dir_ / "logs/error_log").string() + "'").out; }
     const std::string& queue() const { return queue_; }
-    fs::path out() const { return dir_ / "out"; }
+    const fs::path& out() const { return out_; }
     // An operator's command against this server (cupsdisable, cupsreject, lpadmin, lp).
-    bool command(const std::string& line) const {
-        return run("CUPS_SERVER='" + socket_.string() + "' " + line).status == 0;
-    }
+    bool command(const std::string& line) const { return output(line).status == 0; }
+    Ran output(const std::string& line) const { return run("CUPS_SERVER='" + socket_.string() + "' " + line); }
     bool lpadmin(const std::string& args) const { return command("/usr/sbin/lpadmin " + args); }
 
 private:
-    fs::path dir_, socket_;
+    fs::path out_, dir_, socket_;
     std::string queue_, pdfConf_;
     pid_t pid_ = -1;
     bool ok_ = false;

@@ -371,8 +371,7 @@ TEST(PrintCups, HeldAndCanceledJobsAreReported) {
     const PrintSettings settings = cardSettings(cups.queue());
     writeFileAtomically(dir / "card.pdf", renderCardPdf(readCardContent(kept.folder, kept.code, kept.url, settings), settings));
     // A job held by the operator's hand (lp -H indefinite): what the worker's watch reports for such a job.
-    const Ran lp = run("CUPS_SERVER='" + (dir / "cups" / "cups.sock").string() + "' lp -H indefinite -d " +
-                       cups.queue() + " '" + (dir / "card.pdf").string() + "'");
+    const Ran lp = cups.output("lp -H indefinite -d " + cups.queue() + " '" + (dir / "card.pdf").string() + "'");
     std::smatch m;
     ASSERT_TRUE(std::regex_search(lp.out, m, std::regex(cups.queue() + "-(\\d+)"))) << lp.out;
     const JobState j = queryJob(std::stoi(m[1]));

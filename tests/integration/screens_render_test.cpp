@@ -412,6 +412,30 @@ TEST(ScreensPixels, RevealShowsTheAvatarAndSwapsLabelsWithTheButtons) {
     EXPECT_EQ(pixelsNear(sw, swapped.layout().leftLabel, kStartGreen, 10), 0);
 }
 
+// The printer's news on the operator menu (issue 23's card): none while printing is off, grey while all is well,
+// red when the operator has to act (out of paper, stopped), in the status lines under the menu.
+TEST(ScreensPixels, OperatorMenuShowsThePrintersNewsRedWhenItIsAProblem) {
+    ScreenRenderer& r = renderer(Language::English, {1280, 720});
+    ScreenModel m;
+    m.id = ScreenId::OperatorMenu;
+    m.menuPage = OperatorPage::Menu;
+    ScreenInputs in;
+    const cv::Mat off = r.draw(m, in).clone();
+    in.operatorInfo.printer = "queue photo: idle, accepting jobs";
+    const cv::Mat fine = r.draw(m, in).clone();
+    in.operatorInfo.printer = "queue photo: stopped, accepting jobs: out of paper (media-empty-error)";
+    in.operatorInfo.printerProblem = true;
+    const cv::Mat problem = r.draw(m, in).clone();
+    const auto red = [](const cv::Mat& screen) {
+        cv::Mat mask;
+        cv::inRange(screen, cv::Scalar(40, 40, 180), cv::Scalar(110, 110, 255), mask);
+        return cv::countNonZero(mask);
+    };
+    EXPECT_GT(cv::norm(off, fine, cv::NORM_L1), 1e4) << "the printer's line is drawn";
+    EXPECT_LT(red(fine), 50);
+    EXPECT_GT(red(problem), 500) << "a problem is drawn in red";
+}
+
 TEST(ScreensPixels, AvatarAlphaIsComposited) {
     ScreenModel m;
     m.id = ScreenId::Reveal;
