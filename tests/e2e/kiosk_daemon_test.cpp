@@ -3,6 +3,7 @@
 // reaches the front guide, which says "no face" from the face cascade alone, the watchdog pings keep their
 // interval (half of WATCHDOG_USEC) on our own NOTIFY_SOCKET, and SIGTERM ends it within 2 s with exit code 0.
 #include "kiosk_daemon_checks.h"
+#include "process_sockets.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>
@@ -120,6 +121,8 @@ TEST(KioskDaemon, GuideSaysNoFaceKeepsPingingAndStopsPromptlyWhileTheModelIsStil
     EXPECT_GE(notify.pingsSince(from), 4) << "3 s in the guide";
     EXPECT_LE(notify.pingsSince(from), 6) << "pings faster than half of WATCHDOG_USEC";
     EXPECT_LT(notify.longestGapSeconds(from, to), kWatchdogUsec / 1e6) << "a watchdog ping came late";
+    // [share] and [print] at their defaults: the running kiosk holds no TCP listening or bound UDP socket.
+    EXPECT_EQ(listeningSockets(pid), std::vector<std::string>{}) << "the kiosk listens on the network";
 
     // SIGTERM while the model is still loading: gone within 2 s, exit code 0.
     const auto term = std::chrono::steady_clock::now();

@@ -1,6 +1,7 @@
 // `avatarbooth share` as the unit runs it: with the default configuration it listens nowhere and says why; turned
 // on, it listens exactly where it is told (read back from /proc/net/tcp through the process's own sockets), answers,
 // and stops on SIGTERM with its counts.
+#include "process_sockets.h"
 #include "run_binary.h"
 #include "test_paths.h"
 
@@ -31,30 +32,6 @@ std::string readText(const fs::path& path) {
     std::stringstream s;
     s << in.rdbuf();
     return s.str();
-}
-
-// The "address:port" (hex, as the kernel writes them) of every TCP socket of `pid` in the LISTEN state.
-std::vector<std::string> listeningSockets(pid_t pid) {
-    std::set<std::string> inodes;
-    const fs::path fds = "/proc/" + std::to_string(pid) + "/fd";
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator(fds, ec)) {
-        const std::string target = fs::read_symlink(e.path(), ec).string();
-        if (target.rfind("socket:[", 0) == 0) inodes.insert(target.substr(8, target.size() - 9));
-    }
-    std::vector<std::string> out;
-    for (const char* table : {"tcp", "tcp6"}) {
-        std::ifstream in("/proc/" + std::to_string(pid) + "/net/" + table);
-        std::string line;
-        std::getline(in, line);  // the header
-        while (std::getline(in, line)) {
-            std::istringstream f(line);
-            std::string sl, local, remote, state, queues, timer, retransmits, uid, timeout, inode;
-            f >> sl >> local >> remote >> state >> queues >> timer >> retransmits >> uid >> timeout >> inode;
-            if (state == "0A" && inodes.count(inode)) out.push_back(local);
-        }
-    }
-    return out;
 }
 
 }  // namespace
@@ -100,7 +77,7 @@ TEST(ShareCli, ListensWhereToldAnswersAndStopsOnSigterm) {
     ASSERT_GT(port, 0) << readText(log);
     // Exactly one listening socket, on 127.0.0.1 (7F000001 as the kernel writes it) and the port it printed.
     char expected[32];
-    std::snprintf(expected, sizeof expected, "0100007F:%04X", port);
+    std::snprintf(expected, sizeof expected, "tcp 0100007F:%04X", port);
     EXPECT_EQ(listeningSockets(pid), std::vector<std::string>{expected});
     httplib::Client c("127.0.0.1", port);
     const auto r = c.Get("/s/0123456789abcdef0123456789abcdef");
