@@ -48,6 +48,8 @@ test_packages=(
   xvfb
   # the thanks screen's QR code is read back from its screenshot (zbarimg)
   zbar-tools
+  # the share server's HTTPS test makes itself a certificate
+  openssl
   # the printed card's tests start their own CUPS scheduler with a PDF printer (cups-pdf, which pulls in cups-filters
   # and Ghostscript) and read the PDF back (pdfinfo, pdftotext, pdftoppm)
   cups-daemon cups-client printer-driver-cups-pdf poppler-utils

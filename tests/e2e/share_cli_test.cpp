@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <httplib.h>
+#include <openssl/x509_vfy.h>
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -16,6 +17,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -49,16 +51,25 @@ TEST(ShareCli, OffByDefaultListensNowhere) {
         << r.output;
 }
 
-TEST(ShareCli, ListensWhereToldAnswersAndStopsOnSigterm) {
-    const fs::path dir = scratchDir("share_cli_on");
+namespace {
+
+// `avatarbooth share` started on a free loopback port with [share] on and `extra` in its config; the port it
+// printed (0 when it printed none within 5 s, the process then killed).
+struct ShareProcess {
+    pid_t pid = -1;
+    int port = 0;
+    fs::path log;
+};
+
+ShareProcess startShare(const fs::path& dir, const std::string& extra = "") {
     fs::create_directories(dir / "sessions");
     std::ofstream(dir / "booth.toml") << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n"
-                                      << "[share]\nenabled = true\nlisten = \"127.0.0.1:1\"\n";
-    const fs::path log = dir / "log.txt";
-    const pid_t pid = fork();
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-        const int out = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+                                      << "[share]\nenabled = true\nlisten = \"127.0.0.1:1\"\n" << extra;
+    ShareProcess p;
+    p.log = dir / "log.txt";
+    p.pid = fork();
+    if (p.pid == 0) {
+        const int out = open(p.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         dup2(out, 1);
         dup2(out, 2);
         const std::string bin = binary().string(), config = (dir / "booth.toml").string();
@@ -66,14 +77,26 @@ TEST(ShareCli, ListensWhereToldAnswersAndStopsOnSigterm) {
               static_cast<char*>(nullptr));
         _exit(127);
     }
-    int port = 0;
-    for (int i = 0; i < 250 && port == 0; ++i) {
-        const std::string text = readText(log);
+    for (int i = 0; i < 250 && p.port == 0 && p.pid > 0; ++i) {
+        const std::string text = readText(p.log);
         const std::size_t at = text.find("listening on 127.0.0.1:");
-        if (at != std::string::npos) port = std::atoi(text.c_str() + at + 23);
+        if (at != std::string::npos) p.port = std::atoi(text.c_str() + at + 23);
         else std::this_thread::sleep_for(20ms);
     }
-    if (port == 0) kill(pid, SIGKILL);
+    if (p.port == 0 && p.pid > 0) {
+        kill(p.pid, SIGKILL);
+        waitpid(p.pid, nullptr, 0);
+    }
+    return p;
+}
+
+}  // namespace
+
+TEST(ShareCli, ListensWhereToldAnswersAndStopsOnSigterm) {
+    const ShareProcess share = startShare(scratchDir("share_cli_on"));
+    const pid_t pid = share.pid;
+    const int port = share.port;
+    const fs::path& log = share.log;
     ASSERT_GT(port, 0) << readText(log);
     // Exactly one listening socket, on 127.0.0.1 (7F000001 as the kernel writes it) and the port it printed.
     char expected[32];
@@ -97,4 +120,35 @@ TEST(ShareCli, ListensWhereToldAnswersAndStopsOnSigterm) {
     EXPECT_TRUE(exited) << "not stopped within 3 s of SIGTERM";
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << readText(log);
     EXPECT_NE(readText(log).find("stopped; 0 served, 1 not found"), std::string::npos) << readText(log);
+}
+
+// With the operator's certificate it speaks HTTPS only: a client that trusts that certificate gets the same 404 for
+// an unknown token, and plain HTTP on the same port gets no page.
+TEST(ShareCli, ServesHttpsWithTheOperatorsCertificate) {
+    const fs::path dir = scratchDir("share_cli_tls");
+    fs::create_directories(dir);
+    const fs::path cert = dir / "booth.crt", key = dir / "booth.key";
+    const std::string make = "openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=127.0.0.1 -addext "
+                             "subjectAltName=IP:127.0.0.1 -keyout '" + key.string() + "' -out '" + cert.string() +
+                             "' >/dev/null 2>&1";
+    if (std::system(make.c_str()) != 0) GTEST_SKIP() << "openssl could not make a test certificate";
+    const ShareProcess share = startShare(dir, "tls_certificate = \"" + cert.string() + "\"\ntls_key = \"" +
+                                                   key.string() + "\"\n");
+    ASSERT_GT(share.port, 0) << readText(share.log);
+    EXPECT_NE(readText(share.log).find("(https)"), std::string::npos) << readText(share.log);
+    httplib::SSLClient tls("127.0.0.1", share.port);
+    tls.set_ca_cert_path(cert.c_str());
+    tls.enable_server_certificate_verification(true);
+    const auto r = tls.Get("/s/0123456789abcdef0123456789abcdef");
+    ASSERT_TRUE(r) << httplib::to_string(r.error());
+    EXPECT_EQ(r->status, 404);
+    EXPECT_EQ(tls.get_openssl_verify_result(), X509_V_OK);
+    httplib::Client plain("127.0.0.1", share.port);
+    plain.set_read_timeout(3, 0);
+    const auto p = plain.Get("/");
+    EXPECT_TRUE(!p || p->status == 400) << "plain HTTP on the HTTPS port answered " << p->status;
+    kill(share.pid, SIGTERM);
+    int status = 0;
+    waitpid(share.pid, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << readText(share.log);
 }
