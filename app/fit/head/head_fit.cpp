@@ -247,8 +247,7 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         // to the measured ones would undo what the modifiers found. With a modifier basis the head is scaled
         // uniformly by the face's width (dlib's jaw line: no hair in it) and the modifiers (the head's own
         // scale-vert/-depth among them) take its proportions from the landmarks; the height and depth include the
-        // hair, and scaling by them stretched the face (on the synthetic population the fit from ground-truth
-        // landmarks came 0.1-0.4 mm nearer the true face without it). They still say whether it is a head at all.
+        // hair, and scaling by them stretched the face. They still say whether it is a head at all.
         if (round == 0) {
             fit.measuredExtents = glm::dvec3(widthPhoto / widthBase, heightPhoto / heightBase, depthPhoto / depthBase);
             fit.axisScale = base.modifiers ? glm::dvec3(fit.measuredExtents.x) : fit.measuredExtents;

@@ -33,12 +33,10 @@ struct ModifierTarget {
 
 struct ModifierFitOptions {
     // lambda, in square millimetres per unit weight squared: a modifier at full weight must remove this much squared
-    // error to be worth it. (300 held the face near the average head: the population's fits from ground-truth
-    // landmarks came out 0.5 mm further from the truth than at 30.)
+    // error to be worth it (README, "How near the fit comes", has the figures this was chosen by).
     double regularisation = 30.0;
-    // Groups held more firmly: the head's and the neck's shape and the macro directions (age, weight, ...) move the
-    // whole skull, which only the outline rays see (through hair); the face's landmarks alone would bend it (the
-    // shared scan's whole head came 0.2 mm further from the scan at 30 than at 300).
+    // Groups held more firmly: the head's and the neck's shape move the whole skull, which only the outline rays see
+    // (through hair); the face's landmarks alone would bend it.
     std::map<std::string, double> groupRegularisation = {{"head", 300.0}, {"neck", 300.0}};
     int sweeps = 400;  // projected Gauss-Seidel sweeps over the normal equations
     // Huber's threshold in millimetres (0: plain least squares) and how many times the weights are made again. A
