@@ -6,7 +6,7 @@
 // view as (z, y), plus a translation (t_x, t_y, t_z) of the photos' frames against the head (the frames are placed
 // by the eye midpoint and the ear hole of the head before its shape is known). Minimised:
 //   sum over targets |projected vertex - target|^2 + lambda sum_k w_k^2,  0 <= w_k <= 1,
-// (for an outline target, (normal . (projected vertex - target))^2),
+// (for an outline target, the error's parts along its normal and along the outline, each with its weight),
 // so w = 0 (the average head) is what the photos must argue the head away from.
 #pragma once
 
@@ -25,9 +25,10 @@ struct ModifierTarget {
     glm::dvec2 target{0.0};  // millimetres, in the view's plane
     glm::dvec2 weight{1.0};  // of each coordinate's squared error (0: the photo does not measure it)
     // A point measured on a smooth stretch of outline (a contour ray's crossing, the profile's chin or brow) says
-    // how far out the outline is, not where along it the vertex lies: with a unit `normal` (the outline's, in the
-    // view's plane) only the distance along it counts (point-to-line, weight.x), and the vertex may slide along
-    // the outline freely. Pinning it along the outline too would hold the shape at the base head's there.
+    // how far out the outline is, not where along it the vertex lies: with a nonzero `normal` (the outline's, in
+    // the view's plane) the rows are the error along the normal (weight.x: point-to-line) and along the outline
+    // (weight.y, 0 for a ray's crossing: the vertex slides freely). Pinning it along the outline at full weight
+    // would hold the shape at the base head's there.
     glm::dvec2 normal{0.0};
 };
 
