@@ -7,6 +7,7 @@ import puppeteer from 'puppeteer-core';
 import { existsSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
+import { viewerPixels } from './viewer_pixels.mjs';
 
 const [report, screenshot] = process.argv.slice(2);
 if (!report || !screenshot) {
@@ -46,32 +47,16 @@ try {
   }
   const ids = await page.$$eval('model-viewer', (all) => all.map((el) => el.dataset.id));
   for (const id of ids) {
-    const result = await page.evaluate(async (id) => {
-      const el = document.querySelector(`model-viewer[data-id="${CSS.escape(id)}"]`);
-      if (el.dataset.state !== 'loaded' || !el.loaded) return { state: el.dataset.state };
-      el.scrollIntoView();
-      await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
-      // A snapshot of what the viewer draws; count the pixels the avatar covers and how much they vary.
-      const blob = await el.toBlob({ idealAspect: false });
-      const bitmap = await createImageBitmap(blob);
-      const canvas = document.createElement('canvas');
-      canvas.width = bitmap.width;
-      canvas.height = bitmap.height;
-      const ctx = canvas.getContext('2d');
-      ctx.drawImage(bitmap, 0, 0);
-      const data = ctx.getImageData(0, 0, canvas.width, canvas.height).data;
-      let covered = 0, sum = 0, sum2 = 0;
-      for (let i = 0; i < data.length; i += 4) {
-        if (data[i + 3] < 128) continue;
-        covered += 1;
-        const y = 0.299 * data[i] + 0.587 * data[i + 1] + 0.114 * data[i + 2];
-        sum += y;
-        sum2 += y * y;
-      }
-      const mean = covered ? sum / covered : 0;
-      return { state: 'loaded', width: canvas.width, height: canvas.height, coveredFraction: covered / (data.length / 4),
-               lumaStd: covered ? Math.sqrt(Math.max(0, sum2 / covered - mean * mean)) : 0 };
-    }, id);
+    const el = await page.evaluateHandle(
+        (id) => document.querySelector(`model-viewer[data-id="${CSS.escape(id)}"]`), id);
+    const loaded = await el.evaluate((v) => {
+      if (v.dataset.state !== 'loaded' || !v.loaded) return false;
+      v.scrollIntoView();
+      return true;
+    });
+    const result = loaded ? { state: 'loaded', ...(await el.evaluate(viewerPixels)) }
+                          : { state: await el.evaluate((v) => v.dataset.state) };
+    await el.dispose();
     findings.pixels[id] = result;
     if (result.state !== 'loaded') { findings.failedViewers.push(id); continue; }
     findings.loaded += 1;

@@ -6,6 +6,7 @@
 // Prints one JSON object with the findings; exit code 0 when all is well, 1 otherwise, 2 on a usage/launch error.
 import puppeteer from 'puppeteer-core';
 import { existsSync } from 'node:fs';
+import { viewerPixels } from './viewer_pixels.mjs';
 
 const [url, screenshot] = process.argv.slice(2);
 if (!url || !screenshot) {
@@ -53,29 +54,7 @@ try {
     src: el.getAttribute('src'), iosSrc: el.getAttribute('ios-src'), ar: el.hasAttribute('ar'),
     modes: el.getAttribute('ar-modes') }));
   if (findings.loaded) {
-    findings.pixels = await page.evaluate(async () => {
-      const el = document.querySelector('model-viewer');
-      await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
-      const blob = await el.toBlob({ idealAspect: false });
-      const bitmap = await createImageBitmap(blob);
-      const canvas = document.createElement('canvas');
-      canvas.width = bitmap.width;
-      canvas.height = bitmap.height;
-      const ctx = canvas.getContext('2d');
-      ctx.drawImage(bitmap, 0, 0);
-      const data = ctx.getImageData(0, 0, canvas.width, canvas.height).data;
-      let covered = 0, sum = 0, sum2 = 0;
-      for (let i = 0; i < data.length; i += 4) {
-        if (data[i + 3] < 128) continue;
-        covered += 1;
-        const y = 0.299 * data[i] + 0.587 * data[i + 1] + 0.114 * data[i + 2];
-        sum += y;
-        sum2 += y * y;
-      }
-      const mean = covered ? sum / covered : 0;
-      return { width: canvas.width, height: canvas.height, coveredFraction: covered / (data.length / 4),
-               lumaStd: covered ? Math.sqrt(Math.max(0, sum2 / covered - mean * mean)) : 0 };
-    });
+    findings.pixels = await page.$eval('model-viewer', viewerPixels);
   }
   findings.fitsTheScreen = await page.evaluate(() => document.documentElement.scrollWidth <= window.innerWidth);
   await page.screenshot({ path: screenshot, fullPage: true });
