@@ -136,6 +136,9 @@ struct ViewTargets {
 // subnasale are corners, measured both ways; the front photo gives the heights of the rest.
 bool onSmoothOutline(const std::string& name) { return name != "nose_tip" && name != "subnasale"; }
 
+// A contour ray's crossing (METHODS §1 step 4), as against a landmark: by the name ViewTargets gives it.
+bool isContourTarget(const std::string& name) { return name.find("_contour_") != std::string::npos; }
+
 }  // namespace
 
 glm::dvec2 PhotoFrame::toHead(const cv::Point2d& px) const {
@@ -333,7 +336,7 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         for (const ViewTargets* view : {&frontT, &sideT})
             for (std::size_t k = 0; k < view->vertices.size(); ++k) {
                 // The outline rays meet hair as often as skin: they shape the head less than the landmarks do.
-                const bool contour = view->targets[k].first.find("_contour_") != std::string::npos;
+                const bool contour = isContourTarget(view->targets[k].first);
                 const bool onOutline = glm::dot(view->outlineNormals[k], view->outlineNormals[k]) > 0.0;
                 const double weight = contour ? options.contourWeight : 1.0;
                 // A ray's crossing says nothing about where along the outline the vertex lies; a profile landmark
@@ -360,7 +363,7 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     const auto ridgeOf = [&](const ViewTargets& view) {
         std::vector<double> ridge;
         for (const auto& [name, target] : view.targets)
-            ridge.push_back(name.find("_contour_") != std::string::npos ? 0.0 : landmarkRidge);
+            ridge.push_back(isContourTarget(name) ? 0.0 : landmarkRidge);
         return ridge;
     };
     const RbfWarp frontWarp(frontT.centres, frontT.displacements, options.rbf, ridgeOf(frontT));
