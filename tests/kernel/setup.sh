@@ -65,6 +65,13 @@ echo 'MODULE_LICENSE("GPL");' >> "$W/ext/gpio/irq_sim.c"
 echo 'obj-m := irq_sim.o gpio-sim.o' > "$W/ext/gpio/Kbuild"
 # vkms (the virtual KMS screen, with a writeback connector): CONFIG_DRM_VKMS is off in Debian's kernel; what it
 # uses (drm, drm_kms_helper, drm_shmem_helper) is built as modules there.
+# vkms on 6.1 leaves its encoders' possible_clones empty, which the DRM core turns into "only itself": the writeback
+# connector then cannot share the CRTC with the Virtual-1 screen (drm_atomic_check_valid_clones: EINVAL) and can only
+# capture a CRTC that drives nothing else. The two encoders are made clones of each other, so that the writeback
+# reads back the very frames the screen is shown.
+sed -i 's|DRM_ERROR("Failed to init writeback connector\\n");|&\n\t\telse\n\t\t\tencoder->possible_clones = output->wb_connector.encoder.possible_clones =\n\t\t\t\tdrm_encoder_mask(encoder) \| drm_encoder_mask(\&output->wb_connector.encoder);|' \
+  "$W/ext/vkms/vkms_output.c"
+grep -q 'possible_clones = output->wb_connector' "$W/ext/vkms/vkms_output.c" || { echo "kernel setup: vkms_output.c patch did not apply" >&2; exit 1; }
 printf 'obj-m := vkms.o\nvkms-y := vkms_drv.o vkms_plane.o vkms_output.o vkms_formats.o vkms_crtc.o vkms_composer.o vkms_writeback.o\n' \
   > "$W/ext/vkms/Kbuild"
 make -s -C "$H" M="$W/ext/vimc" -j"$(nproc)" modules >&2
