@@ -211,6 +211,19 @@ struct DumbFramebuffer {
     void* map = MAP_FAILED;
 
     DumbFramebuffer(int device, std::uint32_t width, std::uint32_t height, const std::string& where) : fd(device) {
+        try {
+            make(width, height, where);
+        } catch (...) {
+            release();
+            throw;
+        }
+    }
+    ~DumbFramebuffer() { release(); }
+    DumbFramebuffer(const DumbFramebuffer&) = delete;
+    DumbFramebuffer& operator=(const DumbFramebuffer&) = delete;
+
+private:
+    void make(std::uint32_t width, std::uint32_t height, const std::string& where) {
         drm_mode_create_dumb create{};
         create.width = width;
         create.height = height;
@@ -230,7 +243,7 @@ struct DumbFramebuffer {
         map = ::mmap(nullptr, size, PROT_READ, MAP_SHARED, fd, static_cast<off_t>(mapReq.offset));
         if (map == MAP_FAILED) throw BoothError(ErrorKind::Device, where, failure("mmap of the dumb buffer", errno));
     }
-    ~DumbFramebuffer() {
+    void release() {
         if (map != MAP_FAILED) ::munmap(map, size);
         if (fb != 0) drmModeRmFB(fd, fb);
         if (handle != 0) {
@@ -238,9 +251,9 @@ struct DumbFramebuffer {
             destroy.handle = handle;
             drmIoctl(fd, DRM_IOCTL_MODE_DESTROY_DUMB, &destroy);
         }
+        map = MAP_FAILED;
+        fb = handle = 0;
     }
-    DumbFramebuffer(const DumbFramebuffer&) = delete;
-    DumbFramebuffer& operator=(const DumbFramebuffer&) = delete;
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "kms_scanout.h"
 
 #include "common/error.h"
+#include "drivers/display/display_factory.h"
 #include "drivers/display/kms_display.h"
 
 #include <gtest/gtest.h>
@@ -162,6 +163,20 @@ TEST_F(Vkms, ARotatedPanelGetsTheFrameTurnedClockwise) {
     const cv::Mat written = display.readBack();
     EXPECT_EQ(maxDifference(written, turned), 0.0);
     EXPECT_EQ(written.at<cv::Vec3b>(0, kPanel.width - 1), cv::Vec3b(0, 0, 255));  // the frame's top-left corner
+}
+
+// What `backend = "auto"` does on a board with a screen: kms, on the screen the kernel has.
+TEST_F(Vkms, AutoChoosesTheKmsScreen) {
+    DisplaySettings settings;
+    settings.backend = "auto";
+    const OpenedDisplay opened = createDisplay(settings);
+    ASSERT_TRUE(opened.display);
+    EXPECT_EQ(opened.description.rfind("display: kms " + card_ + " Virtual-1 640x360", 0), 0u) << opened.description;
+    const cv::Mat frame = testCard(opened.display->size(), 0);
+    opened.display->present(frame);
+    auto* kms = dynamic_cast<KmsDisplay*>(opened.display.get());
+    ASSERT_NE(kms, nullptr);
+    EXPECT_EQ(maxDifference(kms->readBack(), frame), 0.0);
 }
 
 // An unplugged screen: the connector's status forced to "off" through sysfs, what the kernel reports when a
