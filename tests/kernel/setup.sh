@@ -81,7 +81,7 @@ mkdir -p img/lib/modules/"$KV"/extra && cp "$W"/ext/{vimc,gpio,vkms}/*.ko img/li
 depmod -b "$W/dl/img" "$KV"
 # A pruned module tree for the guest (a few MB instead of 400 MB).
 R=$W/kroot/lib/modules/$KV; mkdir -p "$R"
-for m in vivid vimc gpio-sim vkms configfs; do
+for m in vivid vimc gpio-sim vkms virtio-gpu configfs; do
   modprobe -d "$W/dl/img" -S "$KV" --show-depends $m | awk '$1 == "insmod" {print $2}'
 done | sort -u | while read -r f; do
   rel=${f#*/lib/modules/$KV/}; mkdir -p "$R/$(dirname "$rel")"; cp "$f" "$R/$rel"
