@@ -1,8 +1,9 @@
 // The booth daemon end to end in the guest: `avatarbooth run` with the vivid camera, gpio-sim buttons and the
 // KMS display on vkms goes from attract to the front guide on a press of the start button made with the sim's `pull`
 // attribute; vivid shows no face, so the guide says so (its screenshot's hint text is the "no face" one, from the
-// face cascade alone: the landmark model is still loading -- a named pipe that never delivers it; and the screen vkms
-// scans out, read back from the kernel, is that screenshot) and never counts down, and the booth stays up -- systemd watchdog pings (WATCHDOG_USEC=10 s, the shipped unit's: one every 5 s) keep coming on our own
+// face cascade alone: the landmark model is still loading -- a named pipe that never delivers it; and the screen
+// vkms scans out, read back from the kernel, is that screenshot) and never counts down, and the booth stays up --
+// systemd watchdog pings (WATCHDOG_USEC=10 s, the shipped unit's: one every 5 s) keep coming on our own
 // NOTIFY_SOCKET -- until SIGTERM, which ends it promptly with exit code 0 although the model load has not finished.
 #include "kernel_guest.h"
 #include "kiosk_daemon_checks.h"
