@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Prepares the qemu guest for the `kernel` tests: Debian's stock kernel, its vivid module, vimc/gpio-sim/irq_sim/vkms
-# built out of tree from linux-source-6.1, a pruned module tree and a busybox initramfs. Cached per kernel version.
+# Prepares the qemu guest for the `kernel` tests: Debian's stock kernel, its vivid and virtio-gpu modules,
+# vimc/gpio-sim/irq_sim/vkms built out of tree from linux-source-6.1, a pruned module tree and a busybox initramfs.
+# Cached per kernel version.
 # Usage: tests/kernel/setup.sh CACHE_DIR   -> prints CACHE_DIR/<kernel version> (holds vmlinuz, initrd.img, kroot/)
 # Needs root for apt-get when packages are missing; ~2-3 min the first time, nothing once cached (~20 MB kept).
 set -euo pipefail
