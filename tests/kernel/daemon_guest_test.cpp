@@ -4,7 +4,8 @@
 // face cascade alone: the landmark model is still loading -- a named pipe that never delivers it; and the screen
 // vkms scans out, read back from the kernel, is that screenshot) and never counts down, and the booth stays up --
 // systemd watchdog pings (WATCHDOG_USEC=10 s, the shipped unit's: one every 5 s) keep coming on our own
-// NOTIFY_SOCKET -- until SIGTERM, which ends it promptly with exit code 0 although the model load has not finished.
+// NOTIFY_SOCKET -- also while the screen is switched off (vkms's connector forced off) and after it comes back by
+// itself, until SIGTERM, which ends it promptly with exit code 0 although the model load has not finished.
 #include "kernel_guest.h"
 #include "kiosk_daemon_checks.h"
 #include "kms_scanout.h"
@@ -78,7 +79,8 @@ TEST(Daemon, AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWithoutAFace
     ASSERT_EQ(kernel_test::modprobe("vkms enable_writeback=1"), 0);
     const std::string card = kernel_test::vkmsCard();
     ASSERT_FALSE(card.empty()) << "no vkms card";
-    ASSERT_TRUE(writeFile("/sys/class/drm/" + fs::path(card).filename().string() + "-Virtual-1/status", "detect"));
+    const std::string connectorStatus = "/sys/class/drm/" + fs::path(card).filename().string() + "-Virtual-1/status";
+    ASSERT_TRUE(writeFile(connectorStatus, "detect"));
     kernel_test::run("mountpoint -q /sys/kernel/config || mount -t configfs none /sys/kernel/config");
     fs::create_directories(kConfig / "bank0");
     ASSERT_TRUE(writeFile(kConfig / "bank0/num_lines", "8"));
@@ -167,7 +169,8 @@ TEST(Daemon, AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWithoutAFace
     const double startSeconds = secondsSince(started);
     double guideSeconds = 0.0, stopSeconds = 0.0, longestGap = 0.0;
     int guidePings = 0;
-    bool guide = false;
+    bool guide = false, screenLost = false, screenBack = false;
+    double screenBackSeconds = 0.0;
     cv::Mat screen;  // what vkms scans out on the guide, read back from the kernel
     std::string screenWhy;
     if (attract) {
@@ -182,9 +185,20 @@ TEST(Daemon, AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWithoutAFace
         guideSeconds = secondsSince(pressed);
         // The first analysis's hint (the screenshot is taken again with it when it came later than the picture).
         waitFor([&] { return readFile(log).find("front_guide: hint no_face") != std::string::npos; }, 60s);
-        // It stays in the guide: no face, so no countdown, and the watchdog pings keep coming, one every 5 s.
+        // It stays in the guide: no face, so no countdown, and the watchdog pings keep coming, one every 5 s --
+        // also while the screen is switched off (the connector's status forced off, as a pulled HDMI cable shows):
+        // the booth goes on without it, the visitor's session too, and reopens the screen by itself once it is
+        // back ("detect"), without a restart.
         const auto from = std::chrono::steady_clock::now();
-        waitFor([] { return false; }, 12s);
+        EXPECT_TRUE(writeFile(connectorStatus, "off"));
+        screenLost = waitFor([&] { return readFile(log).find("screen lost: kms " + card) != std::string::npos; }, 20s);
+        waitFor([] { return false; }, 4s);
+        EXPECT_TRUE(writeFile(connectorStatus, "detect"));
+        const auto detected = std::chrono::steady_clock::now();
+        screenBack = waitFor([&] { return readFile(log).find("screen back after") != std::string::npos; }, 30s);
+        screenBackSeconds = secondsSince(detected);
+        waitFor([] { return false; }, std::max<std::chrono::steady_clock::duration>(
+                                           3s, from + 12s - std::chrono::steady_clock::now()));
         const auto to = std::chrono::steady_clock::now();
         guidePings = notify.pingsSince(from);
         longestGap = notify.longestGapSeconds(from, to);
@@ -205,8 +219,10 @@ TEST(Daemon, AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWithoutAFace
         }
     }
     std::printf("[daemon] attract after %.1f s, front guide %.1f s after the press, %d watchdog pings in 12 s of the "
-                "guide (longest gap %.1f s, %zu in all), stopped %.1f s after SIGTERM\n",
-                startSeconds, guideSeconds, guidePings, longestGap, notify.watchdog.size(), stopSeconds);
+                "guide with the screen off for 4 s of it (longest gap %.1f s, %zu in all), the screen back %.1f s after "
+                "detect, stopped %.1f s after SIGTERM\n",
+                startSeconds, guideSeconds, guidePings, longestGap, notify.watchdog.size(), screenBackSeconds,
+                stopSeconds);
     const std::string output = readFile(log);
     // The booth's own figures (`-v`): its start-up steps and the main-loop steps that took over 0.5 s, with where
     // their time went.
@@ -255,6 +271,18 @@ TEST(Daemon, AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWithoutAFace
     EXPECT_NE(output.find(node), std::string::npos) << "the log does not name the vivid camera\n" << output;
     EXPECT_NE(output.find("kms " + card + " Virtual-1 640x360"), std::string::npos)
         << "the log does not name the vkms screen\n" << output;
+    // The screen switched off and on in the guide: lost, logged once, back without a restart (one READY=1, one
+    // session), and the screen scanned out after it (above) is the guide's again.
+    EXPECT_TRUE(screenLost) << "the log does not say the screen was lost\n" << output;
+    EXPECT_TRUE(screenBack) << "the screen did not come back\n" << output;
+    EXPECT_NE(output.find("recovery 1"), std::string::npos) << output;
+    std::size_t losses = 0;
+    for (std::size_t at = output.find("screen lost:"); at != std::string::npos; at = output.find("screen lost:", at + 1))
+        ++losses;
+    EXPECT_EQ(losses, 1u) << "the loss was not logged once\n" << output;
+    EXPECT_EQ(notify.ready.size(), 1u) << "the booth started again";
+    EXPECT_EQ(output.find("a visitor started a session"), output.rfind("a visitor started a session"))
+        << "the visitor's session did not survive the screen going away\n" << output;
 }
 
 }  // namespace
