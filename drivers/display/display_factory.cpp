@@ -66,11 +66,19 @@ OpenedDisplay createDisplay(const DisplaySettings& settings) {
         if (!choice.backend) throw BoothError(ErrorKind::Device, "display", "no display backend opens: " + passedOver(passed));
         // The last resort is headless; but a board with a KMS connector and no screen on it now (a monitor switched
         // off at start-up) waits for its screen instead, or it would stay headless until the next restart.
-        std::string connectors;
-        if (choice.backend == &table.back() && kmsScreenExpected(settings.drmDevice, settings.connector, &connectors)) {
+        // (Only for want of a screen: a screen that is connected but held by a desktop's compositor stays
+        // headless, as a developer running the booth beside their desktop expects.)
+        if (choice.backend == &table.back() && !kmsScreenAvailable(settings.drmDevice, settings.connector) &&
+            kmsScreenExpected(settings.drmDevice, settings.connector)) {
             out = openKmsScreen(settings, ReopeningDisplay::FirstOpen::MayWait);
-            out.description = "display: " + out.display->describe() + " (auto: waiting for a screen on " +
-                              connectors + "; " + passedOver(passed) + ")";
+            if (!out.reopening->status().ok) {
+                // "display: kms /dev/dri waiting for a screen (auto: kms: /dev/dri/card1: no screen connected
+                // (HDMI-A-1 not connected); window: $DISPLAY is not set)": the passed-over reasons say why.
+                const std::string label = out.display->describe();
+                out.description = "display: " + label.substr(0, label.find(" (")) + " (auto: " + passedOver(passed) + ")";
+            } else {
+                out.description = "display: " + out.display->describe() + " (auto: " + passedOver(passed) + ")";
+            }
             return out;
         }
         try {

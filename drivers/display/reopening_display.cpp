@@ -113,6 +113,7 @@ bool ReopeningDisplay::closeRequested() const { return display_ && display_->clo
 
 std::string ReopeningDisplay::describe() const {
     if (display_) return display_->describe();
+    if (!everOpened_) return label_ + " waiting for a screen (" + status().lastError + ")";
     return lastDescription_ + " (no screen: " + status().lastError + ")";
 }
 

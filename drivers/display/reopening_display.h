@@ -56,7 +56,8 @@ public:
     Rotation rotation() const override { return rotation_; }
     std::vector<KeyEvent> pollKeys() override;
     bool closeRequested() const override;
-    // The display's description, or the last one known with "(no screen: ...)" while lost.
+    // The display's description, or the last one known with "(no screen: why)" while lost, or "LABEL waiting for a
+    // screen (why)" before it ever opened.
     std::string describe() const override;
 
     // Thread-safe.

@@ -265,7 +265,8 @@ TEST_F(Vkms, TheKioskScreenSwitchedOffAndOnComesBackByItself) {
     s = display.status();
     ASSERT_TRUE(s.ok) << s.lastError;
     EXPECT_EQ(s.recoveries, 1);
-    EXPECT_LT(backSeconds, 2.0 + 1.5) << "not back within the retry interval (and an open under emulation)";
+    // The retry interval, and an open under emulation (0.2-3.6 s measured, the first in a process loading Mesa).
+    EXPECT_LT(backSeconds, 2.0 + 3.0) << "not back within the retry interval";
     EXPECT_EQ(display.size(), kPanel) << "not the same mode after the screen came back";
     display.present(after);
     auto* kms = dynamic_cast<KmsDisplay*>(display.current());
@@ -291,8 +292,8 @@ TEST_F(Vkms, AutoWithTheScreenOffAtStartWaitsForItInsteadOfRunningHeadless) {
     EXPECT_EQ(what.find("Writeback"), std::string::npos) << "a writeback connector is no place for a screen: " << what;
     const OpenedDisplay opened = createDisplay(settings);
     ASSERT_NE(opened.reopening, nullptr) << opened.description;
-    EXPECT_NE(opened.description.find("auto: waiting for a screen on " + card_ + " Virtual-1 not connected"),
-              std::string::npos)
+    EXPECT_EQ(opened.description, "display: kms " + card_ + " waiting for a screen (auto: kms: " + card_ +
+                                      ": no screen connected (Virtual-1 not connected); window: $DISPLAY is not set)")
         << opened.description;
     ReopeningDisplay& display = *opened.reopening;
     EXPECT_FALSE(display.status().ok);
