@@ -285,5 +285,124 @@ TEST(Daemon, AttractToFrontGuideOnAGpioPressWithVividAndStaysHealthyWithoutAFace
         << "the visitor's session did not survive the screen going away\n" << output;
 }
 
+// A booth started while its monitor is off, with the default `backend = "auto"`: it does not fall back to headless
+// for good but waits for the screen -- composing at the configured 1280x720 meanwhile, READY and the watchdog as
+// usual -- and once the screen is there ("detect") shows itself on it, laid out for the screen's own 640x360 mode.
+TEST(Daemon, StartedWithTheScreenOffAutoWaitsForItAndLaysOutForItsMode) {
+    AVATARBOOTH_REQUIRE_KERNEL_GUEST();
+    if (!fs::exists(test::binary())) GTEST_SKIP() << test::binary() << " is not built";
+    const char* work = std::getenv("W");
+    ASSERT_TRUE(work && *work) << "$W (the guest's writable folder) not set";
+    const fs::path dir = fs::path(work) / "daemon-screen-off";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    ASSERT_EQ(kernel_test::modprobe("vivid n_devs=1 node_types=0x1"), 0);
+    ASSERT_EQ(kernel_test::modprobe("vkms enable_writeback=1"), 0);
+    const std::string card = kernel_test::vkmsCard();
+    ASSERT_FALSE(card.empty()) << "no vkms card";
+    const std::string connectorStatus = "/sys/class/drm/" + fs::path(card).filename().string() + "-Virtual-1/status";
+    ASSERT_TRUE(writeFile(connectorStatus, "off"));
+    struct Replug {
+        std::string status;
+        ~Replug() { writeFile(status, "detect"); }
+    } replug{connectorStatus};
+    const std::string node = vividNode();
+    ASSERT_FALSE(node.empty());
+    const fs::path model = "/tmp/avatarbooth-daemon-screen-off-model.fifo";  // never delivered, as above
+    fs::remove(model);
+    ASSERT_EQ(mkfifo(model.c_str(), 0600), 0) << std::strerror(errno);
+    const int writer = open(model.c_str(), O_RDWR | O_CLOEXEC);
+    ASSERT_GE(writer, 0) << std::strerror(errno);
+    struct CloseWriter {
+        int fd;
+        ~CloseWriter() { close(fd); }
+    } closeWriter{writer};
+    const fs::path config = dir / "booth.toml";
+    std::ofstream(config) << "[fit]\nlandmark_model = \"" << model.string() << "\"\n"
+                          << "[camera]\nbackend = \"v4l2\"\ndevice = \"" << node << "\"\n"
+                          << "preview_width = 320\npreview_height = 180\n"
+                          << "[buttons]\nbackend = \"sim\"\n"
+                          // backend "auto" (the default), on the vkms card (the guest may have virtio-gpu's too).
+                          << "[display]\ndrm_device = \"" << card << "\"\n"
+                          << "[screen]\nstrings_file = \"" << AVATARBOOTH_TEST_SOURCE_DIR << "/app/assets/strings.toml\"\n"
+                          << "[sessions]\ndirectory = \"" << (dir / "sessions").string() << "\"\n"
+                          << "[reveal]\nstyles = [\"photo\"]\n"
+                          << "[stage]\nenabled = false\n";
+    NotifySocket notify("guest-screen-off");
+    ASSERT_TRUE(notify.ok()) << std::strerror(errno);
+    const fs::path log = dir / "log.txt", screens = dir / "screens";
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        setenv("NOTIFY_SOCKET", notify.env().c_str(), 1);
+        setenv("WATCHDOG_USEC", std::to_string(kWatchdogUsec).c_str(), 1);
+        setenv("EGL_PLATFORM", "surfaceless", 1);
+        unsetenv("DISPLAY");
+        const std::string bin = test::binary().string();
+        execl("/bin/sh", "sh", "-c",
+              ("exec '" + bin + "' -v run --visitor no --config '" + config.string() + "' --screenshots '" +
+               screens.string() + "' > '" + log.string() + "' 2>&1")
+                  .c_str(),
+              static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    int status = 0;
+    bool gone = false;
+    const auto waitFor = [&](const auto& done, std::chrono::steady_clock::duration limit) {
+        const auto end = std::chrono::steady_clock::now() + limit;
+        while (!done() && std::chrono::steady_clock::now() < end && !(gone = gone || waitpid(pid, &status, WNOHANG) == pid)) {
+            notify.drain();
+            std::this_thread::sleep_for(50ms);
+        }
+        notify.drain();
+        return done();
+    };
+    const bool ready = waitFor([&] { return fs::exists(screens / "00_attract.png") && !notify.ready.empty(); }, 300s);
+    const cv::Mat waitingShot = cv::imread((screens / "00_attract.png").string());
+    // Without a screen for a while: the loop goes on (pings), nothing is shown.
+    const auto from = std::chrono::steady_clock::now();
+    waitFor([] { return false; }, 6s);
+    const int pingsWithout = notify.pingsSince(from);
+    ASSERT_TRUE(writeFile(connectorStatus, "detect"));
+    const auto detected = std::chrono::steady_clock::now();
+    const bool connected = waitFor([&] { return readFile(log).find("screen connected after") != std::string::npos; }, 30s);
+    const double connectSeconds = secondsSince(detected);
+    const bool laidOut = waitFor(
+        [&] { return readFile(log).find("the screen is now 640x360 (was 1280x720)") != std::string::npos; }, 30s);
+    waitFor([] { return false; }, 3s);  // a few frames at the new size
+    std::string why;
+    const cv::Mat screen = gone ? cv::Mat() : kernel_test::readScanout(card, why);
+    if (!gone) {
+        kill(pid, SIGTERM);
+        waitFor([&] { return gone; }, 20s);
+        if (!gone) {
+            kill(pid, SIGKILL);
+            waitpid(pid, &status, 0);
+        }
+    }
+    const std::string output = readFile(log);
+    std::printf("[daemon] screen off at start: ready with %d pings in 6 s without a screen, connected %.1f s after "
+                "detect, laid out for 640x360: %s\n", pingsWithout, connectSeconds, laidOut ? "yes" : "no");
+    ASSERT_TRUE(ready) << "no attract screen\n" << output;
+    EXPECT_NE(output.find("display: kms " + card + " waiting for a screen (auto: kms: " + card +
+                          ": no screen connected (Virtual-1 not connected)"),
+              std::string::npos)
+        << "auto did not wait for the KMS screen\n" << output;
+    EXPECT_EQ(output.find("display: headless"), std::string::npos) << output;
+    EXPECT_EQ(waitingShot.size(), cv::Size(1280, 720)) << "not composed at the configured size while waiting";
+    EXPECT_GE(pingsWithout, 1) << "the watchdog stopped without a screen\n" << output;
+    EXPECT_TRUE(connected) << output;
+    EXPECT_TRUE(laidOut) << output;
+    EXPECT_EQ(notify.ready.size(), 1u);
+    ASSERT_FALSE(screen.empty()) << why;
+    EXPECT_EQ(screen.size(), cv::Size(640, 360));
+    // Something is drawn on it (the layout itself is the log's "laid out" line: a 1280x720 frame scaled to the
+    // same aspect would look alike).
+    cv::Scalar mean, stddev;
+    cv::meanStdDev(screen, mean, stddev);
+    EXPECT_GT(stddev[0] + stddev[1] + stddev[2], 10.0) << "the screen is blank";
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "status " << status << "\n" << output;
+}
+
 }  // namespace
 }  // namespace avatarbooth
