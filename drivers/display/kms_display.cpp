@@ -484,4 +484,32 @@ bool kmsScreenAvailable(const std::string& device, const std::string& connector,
     return false;
 }
 
+bool kmsScreenExpected(const std::string& device, const std::string& connector, std::string* what) {
+    const std::vector<std::string> cards = device.empty() ? cardPaths() : std::vector<std::string>{device};
+    std::string seen;
+    bool found = false;
+    for (const auto& path : cards) {
+        const int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+        if (fd < 0) continue;
+        if (drmModeRes* res = drmModeGetResources(fd)) {
+            for (int i = 0; i < res->count_connectors; ++i) {
+                drmModeConnector* conn = drmModeGetConnectorCurrent(fd, res->connectors[i]);
+                if (conn == nullptr) continue;
+                // A writeback connector (vkms's, the Pi's TXP) is no place for a screen.
+                const std::string name = connectorName(conn);
+                if (conn->connector_type != DRM_MODE_CONNECTOR_WRITEBACK && (connector.empty() || connector == name)) {
+                    found = true;
+                    seen += (seen.empty() ? "" : ", ") + path + " " + name +
+                            (conn->connection == DRM_MODE_CONNECTED ? " connected" : " not connected");
+                }
+                drmModeFreeConnector(conn);
+            }
+            drmModeFreeResources(res);
+        }
+        ::close(fd);
+    }
+    if (what != nullptr) *what = seen;
+    return found;
+}
+
 }  // namespace avatarbooth

@@ -53,4 +53,9 @@ private:
 // says what is missing. Opens nothing for longer than the check.
 bool kmsScreenAvailable(const std::string& device, const std::string& connector, std::string* why = nullptr);
 
+// Whether a KMS device (`device` empty: any /dev/dri/card*) has a connector a screen can be plugged into (the one
+// named, else any but writeback), connected or not: a board whose screen is off or unplugged, as opposed to a
+// machine without a display controller. `what` lists them ("/dev/dri/card1 HDMI-A-1 not connected").
+bool kmsScreenExpected(const std::string& device, const std::string& connector, std::string* what = nullptr);
+
 }  // namespace avatarbooth

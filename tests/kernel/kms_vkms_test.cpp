@@ -1,13 +1,15 @@
 // The KMS screen against the kernel's vkms driver: KmsDisplay's whole GBM/EGL/KMS sequence (Mesa's kms_swrast,
 // llvmpipe, on a KMS-only device), the mode the kernel command line chose, page flips paced by the refresh, the
 // pixels that were scanned out read back through vkms's writeback connector (and the scanned-out framebuffer),
-// and a screen unplugged (the connector's forced status) or its driver taken away.
+// a screen unplugged (the connector's forced status) or its driver taken away, and the kiosk's screen (behind
+// ReopeningDisplay) switched off and on while frames keep coming, or off when the booth starts.
 #include "kernel_guest.h"
 #include "kms_scanout.h"
 
 #include "common/error.h"
 #include "drivers/display/display_factory.h"
 #include "drivers/display/kms_display.h"
+#include "drivers/display/reopening_display.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
@@ -18,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace avatarbooth {
@@ -174,7 +177,8 @@ TEST_F(Vkms, AutoChoosesTheKmsScreen) {
     EXPECT_EQ(opened.description.rfind("display: kms " + card_ + " Virtual-1 640x360", 0), 0u) << opened.description;
     const cv::Mat frame = testCard(opened.display->size(), 0);
     opened.display->present(frame);
-    auto* kms = dynamic_cast<KmsDisplay*>(opened.display.get());
+    ASSERT_NE(opened.reopening, nullptr) << "the KMS screen is opened behind its reopening wrapper";
+    auto* kms = dynamic_cast<KmsDisplay*>(opened.reopening->current());
     ASSERT_NE(kms, nullptr);
     EXPECT_EQ(maxDifference(kms->readBack(), frame), 0.0);
 }
@@ -210,6 +214,104 @@ TEST_F(Vkms, AnUnpluggedScreenIsADeviceErrorAndAReplugGivesItBack) {
     const cv::Mat frame = testCard(display.size(), 1);
     display.present(frame);
     EXPECT_EQ(maxDifference(display.readBack(), frame), 0.0);
+}
+
+// Presents `frame` as the kiosk does (a frame every 33 ms at most: present() does not pace a lost screen) until
+// `done` or `limit`; returns the frames presented.
+template <typename Done>
+int presentUntil(Display& display, const cv::Mat& frame, Done done, std::chrono::milliseconds limit) {
+    int frames = 0;
+    for (const auto end = Clock::now() + limit; !done() && Clock::now() < end; ++frames) {
+        const auto next = Clock::now() + std::chrono::milliseconds(33);
+        display.present(frame);
+        std::this_thread::sleep_until(next);
+    }
+    return frames;
+}
+
+// The booth's screen switched off and on while it runs: the display opened as the kiosk opens it (createDisplay,
+// behind ReopeningDisplay) survives the connector going "off" -- present() goes on without throwing, the DRM node
+// is closed (so vkms could even be unloaded), the status says so -- and after "detect" it is reopened by itself
+// within the 2 s retry interval, in the same mode, and the kernel shows the frames pixel for pixel again.
+TEST_F(Vkms, TheKioskScreenSwitchedOffAndOnComesBackByItself) {
+    const OpenedDisplay opened = createDisplay(settings_);
+    ASSERT_NE(opened.reopening, nullptr);
+    ReopeningDisplay& display = *opened.reopening;
+    const cv::Mat before = testCard(display.size(), 0);
+    display.present(before);
+    display.present(before);
+    ASSERT_TRUE(display.status().ok);
+
+    ASSERT_TRUE(kernel_test::writeFile(status_, "off"));
+    const auto off = Clock::now();
+    const int whileOff = presentUntil(display, before, [] { return false; }, std::chrono::milliseconds(3000));
+    DisplayStatus s = display.status();
+    EXPECT_FALSE(s.ok);
+    EXPECT_NE(s.message.find("Virtual-1"), std::string::npos) << s.message;
+    EXPECT_NE(s.message.find("lost, retrying every 2 s"), std::string::npos) << s.message;
+    EXPECT_GE(s.failedReopens, 1) << "no reopen tried in 3 s";
+    EXPECT_LE(s.failedReopens, 2) << "reopens tried more often than every 2 s";
+    EXPECT_GE(s.framesDropped, static_cast<std::uint64_t>(whileOff) - 1);
+    EXPECT_EQ(display.current(), nullptr);
+    EXPECT_EQ(display.size(), kPanel);
+    std::printf("[vkms] screen off: %d frames presented in %.1f s without it, %d reopens failed: %s\n", whileOff,
+                std::chrono::duration<double>(Clock::now() - off).count(), s.failedReopens, s.lastError.c_str());
+
+    ASSERT_TRUE(kernel_test::writeFile(status_, "detect"));
+    const auto on = Clock::now();
+    const cv::Mat after = testCard(display.size(), 1);
+    presentUntil(display, after, [&] { return display.status().ok; }, std::chrono::milliseconds(6000));
+    const double backSeconds = std::chrono::duration<double>(Clock::now() - on).count();
+    s = display.status();
+    ASSERT_TRUE(s.ok) << s.lastError;
+    EXPECT_EQ(s.recoveries, 1);
+    // The retry interval, and an open under emulation (0.2-3.6 s measured, the first in a process loading Mesa).
+    EXPECT_LT(backSeconds, 2.0 + 3.0) << "not back within the retry interval";
+    EXPECT_EQ(display.size(), kPanel) << "not the same mode after the screen came back";
+    display.present(after);
+    auto* kms = dynamic_cast<KmsDisplay*>(display.current());
+    ASSERT_NE(kms, nullptr);
+    EXPECT_EQ(maxDifference(kms->readBack(), after), 0.0);
+    std::string why;
+    const cv::Mat scanned = kernel_test::readScanout(card_, why);
+    ASSERT_FALSE(scanned.empty()) << why;
+    EXPECT_EQ(maxDifference(scanned, after), 0.0);
+    std::printf("[vkms] screen back %.2f s after detect: %s\n", backSeconds, display.describe().c_str());
+}
+
+// `backend = "auto"` on a board whose monitor is off at start-up (the connector reports no screen, no X display):
+// not headless for good, but the KMS screen waited for, at the configured size until it comes with its own mode.
+TEST_F(Vkms, AutoWithTheScreenOffAtStartWaitsForItInsteadOfRunningHeadless) {
+    ASSERT_TRUE(kernel_test::writeFile(status_, "off"));
+    DisplaySettings settings;
+    settings.backend = "auto";
+    settings.drmDevice = card_;  // vkms's, whatever other card (virtio-gpu) the guest has at the time
+    std::string what;
+    EXPECT_TRUE(displayWaitsForScreen(settings, &what));
+    EXPECT_NE(what.find(card_ + " Virtual-1 not connected"), std::string::npos) << what;
+    EXPECT_EQ(what.find("Writeback"), std::string::npos) << "a writeback connector is no place for a screen: " << what;
+    const OpenedDisplay opened = createDisplay(settings);
+    ASSERT_NE(opened.reopening, nullptr) << opened.description;
+    EXPECT_EQ(opened.description, "display: kms " + card_ + " waiting for a screen (auto: kms: " + card_ +
+                                      ": no screen connected (Virtual-1 not connected); window: $DISPLAY is not set)")
+        << opened.description;
+    ReopeningDisplay& display = *opened.reopening;
+    EXPECT_FALSE(display.status().ok);
+    EXPECT_NE(display.status().message.find("not connected yet"), std::string::npos) << display.status().message;
+    EXPECT_EQ(display.size(), cv::Size(1280, 720)) << "the configured size while waiting";
+    presentUntil(display, testCard(display.size(), 0), [] { return false; }, std::chrono::milliseconds(500));
+
+    ASSERT_TRUE(kernel_test::writeFile(status_, "detect"));
+    presentUntil(display, testCard(display.size(), 0), [&] { return display.status().ok; },
+                 std::chrono::milliseconds(6000));
+    ASSERT_TRUE(display.status().ok) << display.status().lastError;
+    EXPECT_EQ(display.status().recoveries, 0) << "a first connection is not a recovery";
+    ASSERT_EQ(display.size(), kPanel) << "the screen's own mode once it is there";
+    const cv::Mat frame = testCard(display.size(), 1);
+    display.present(frame);
+    auto* kms = dynamic_cast<KmsDisplay*>(display.current());
+    ASSERT_NE(kms, nullptr);
+    EXPECT_EQ(maxDifference(kms->readBack(), frame), 0.0);
 }
 
 // The device itself going away: an open DRM node pins its driver (the file's owner is vkms), so the module cannot
