@@ -32,7 +32,7 @@ struct HeadFitOptions {
     // The first step, with a base head that has a modifier basis: the weights' fit, and how many times it is done
     // again with the shape it found (0: the modifiers are not fitted).
     ModifierFitOptions modifiers;
-    int modifierRounds = 1;
+    int modifierRounds = 2;
     // Weight of an outline point against a landmark's in the modifier fit.
     double contourWeight = 0.3;
     // A profile landmark on a smooth stretch of outline (chin, brow, lips, ...) is measured along the outline's

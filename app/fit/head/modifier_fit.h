@@ -43,7 +43,7 @@ struct ModifierFitOptions {
     // Huber's threshold in millimetres (0: plain least squares) and how many times the weights are made again. A
     // detected landmark is often a millimetre off, and now and then a profile point lands on the wrong bump.
     double robustMm = 1.0;
-    int robustIterations = 4;
+    int robustIterations = 2;
     // Modifier groups held at 0: the ears, which no photo measurement sees (the outline rays pass above and below
     // them), would otherwise be bent to fit rays that meet hair.
     std::vector<std::string> fixedGroups = {"ears"};
