@@ -180,7 +180,7 @@ void checkGpio(const GpioSettings& settings, Report& report) {
         report.fail("gpio", e.what(), ErrorKind::Device);  // the chip went away since the probe
         return;
     }
-    report.ok("gpio", "chip " + chipName);
+    report.ok("gpio", "chip " + chipName + " (" + gpiodLibraryVersion() + ")");
     for (std::size_t i = 0; i < lines.size(); ++i) {
         const GpioLineStatus& s = lines[i];
         const std::string line = labels[i] + ": line " + std::to_string(s.offset) + (s.name.empty() ? "" : " (" + s.name + ")");
