@@ -38,6 +38,8 @@ packages=(
   libopencv-dev opencv-data libdlib-dev libdlib-data
   libtinygltf-dev nlohmann-json3-dev libglm-dev
   libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libx11-dev
+  # (CMake 3.31, trixie's, asks FindOpenGL for libOpenGL.so even when only EGL is wanted)
+  libopengl-dev
   libcli11-dev libspdlog-dev libtomlplusplus-dev libsystemd-dev libgpiod-dev libcamera-dev
   libfreetype-dev fonts-dejavu-core fonts-vlgothic
   # image files (app/common/image_codec): libjpeg-turbo, libpng, libexif (orientation), stb_image (BMP)
