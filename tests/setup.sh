@@ -35,7 +35,12 @@ esac
 # What building and running the booth needs (sim/demo.sh installs these alone) ...
 packages=(
   build-essential cmake pkg-config git
+  # (CPack's .deb runs dpkg-shlibdeps on the files `file` says are ELF: a minimal trixie system has no `file`)
+  file
   libopencv-dev opencv-data libdlib-dev libdlib-data
+  # (dlib's exported CMake file names libblas.so and liblapack.so, which only these ship; trixie's libdlib-dev does
+  # not pull them in)
+  libblas-dev liblapack-dev
   libtinygltf-dev nlohmann-json3-dev libglm-dev
   libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libx11-dev
   # (CMake 3.31, trixie's, asks FindOpenGL for libOpenGL.so even when only EGL is wanted)

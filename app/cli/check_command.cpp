@@ -24,6 +24,8 @@
 #include "drivers/sound/sound_player.h"
 
 #include <nlohmann/json.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 
 #include <unistd.h>
 
@@ -365,6 +367,14 @@ void registerCheckCommand(CLI::App& app) {
                     std::string("Configuration file to check (default: ") + kInstalledConfig + " when it exists)");
     cmd->add_flag("--json", o->json, "Print the results as JSON (for scripts)");
     cmd->callback([o] {
+        if (o->json) {
+            // Stdout is the report's, which a script parses: what the libraries log while the checks run (libcamera
+            // 0.4 complains through spdlog about a machine without dma-buf heaps) goes to stderr instead.
+            const auto level = spdlog::default_logger()->level();
+            auto logger = spdlog::stderr_color_mt("check");
+            logger->set_level(level);
+            spdlog::set_default_logger(logger);
+        }
         Report report;
         const BoothConfig config = checkConfig(o->config, report);
         checkCameras(config.camera, report);

@@ -216,8 +216,9 @@ TEST_F(GpioSim, TheKernelDebouncesTheButtonLinesWhereLibgpiodCan) {
         EXPECT_EQ(lines[i].kernelDebounce, expected) << "line " << lines[i].offset;
     }
     EXPECT_EQ(lines[2].kernelDebounce, std::chrono::microseconds(0)) << "a lamp is an output, never debounced";
-    if (gpiodKernelDebounce())
+    if (gpiodKernelDebounce()) {
         EXPECT_NE(board.description.find("kernel debounce 5000 us"), std::string::npos) << board.description;
+    }
     // A press still arrives as one press and one release through the kernel's filter.
     ASSERT_TRUE(pull(0, false));
     std::this_thread::sleep_for(200ms);
