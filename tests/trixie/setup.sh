@@ -18,10 +18,11 @@ mapfile -t build_packages < <("$root/tests/setup.sh" --print-packages "$suite" |
 # What the stage runs there besides the build: the .deb (dpkg-dev's dpkg-shlibdeps comes with build-essential),
 # the tests' tools (the glTF validator's node, Xvfb for the window test, zbarimg for QR codes, openssl for the
 # share server's certificate, CUPS with the PDF printer and poppler for the printed card), and what the kernel
-# tests use in the qemu guest, which chroots into this root (kmod's modprobe, udevd for libcamera, vimc's IPA).
+# tests use in the qemu guest, which chroots into this root (kmod's modprobe, udevd for libcamera, vimc's IPA,
+# v4l2-ctl for vivid's controls).
 stage_packages=(
   nodejs xvfb zbar-tools openssl cups-daemon cups-client printer-driver-cups-pdf poppler-utils
-  kmod udev libcamera-ipa
+  kmod udev libcamera-ipa v4l-utils
 )
 packages=("${build_packages[@]}" "${stage_packages[@]}")
 
