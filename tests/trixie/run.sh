@@ -37,10 +37,19 @@ in_root() {
   ' in_root "$rootfs" "$root" "$1"
 }
 
+# CPU seconds (user + system) of every child process waited for so far: a phase's CPU time next to its wall time
+# tells what it would take on a quiet machine when other work shares the cores.
+cpu_file="$(mktemp)"
+trap 'rm -f "$cpu_file"' EXIT
+cpu() {  # sets CPU (not in a subshell, where `times` would not see this shell's children)
+  times >"$cpu_file"
+  CPU=$(awk 'NR == 2 { n = 0; for (i = 1; i <= 2; ++i) { split($i, t, /[ms]/); n += t[1] * 60 + t[2] } printf "%d", n }' "$cpu_file")
+}
+
 start=$SECONDS
 "$root/tests/trixie/setup.sh" "$rootfs"
-root_done=$SECONDS
-echo "run: trixie root took $((root_done - start)) s"
+cpu; root_done=$SECONDS root_cpu=$CPU
+echo "run: trixie root took $((root_done - start)) s (CPU $root_cpu s)"
 
 # The targets the stage runs: the booth and its base head, the test executables, the overlay the .deb carries.
 targets="avatarbooth base_head unit_tests integration_tests e2e_tests kernel_tests"
@@ -48,15 +57,15 @@ command -v dtc >/dev/null && targets+=" firmware_overlay"
 echo "trixie: building (preset trixie, build/trixie: $targets)"
 in_root "echo \"trixie: \$(gcc --version | head -1), \$(cmake --version | head -1), libgpiod \$(pkg-config --modversion libgpiod), libcamera \$(pkg-config --modversion libcamera), OpenCV \$(pkg-config --modversion opencv4)\"
   cmake --preset trixie >/dev/null && cmake --build --preset trixie -j $jobs --target $targets"
-build_done=$SECONDS
-echo "run: trixie build took $((build_done - root_done)) s"
+cpu; build_done=$SECONDS build_cpu=$CPU
+echo "run: trixie build took $((build_done - root_done)) s (CPU $((build_cpu - root_cpu)) s)"
 
 # No exit on a failed phase: the later ones still run, and the stage fails if any did.
 rc=0
 echo "trixie: unit, integration and e2e tests (excluded: $exclude)"
 in_root "ctest --preset trixie --timeout 900 --parallel $jobs -L '^(unit|integration|e2e)\$' -E '$exclude' $*" || rc=1
-tests_done=$SECONDS
-echo "run: trixie tests took $((tests_done - build_done)) s"
+cpu; tests_done=$SECONDS tests_cpu=$CPU
+echo "run: trixie tests took $((tests_done - build_done)) s (CPU $((tests_cpu - build_cpu)) s)"
 
 # The guest kernel and its modules are the native stage's (the same bookworm kernel): reuse its cache.
 cache="${KERNEL_GUEST_CACHE:-}"
@@ -68,8 +77,8 @@ echo "trixie: kernel tests of the GPIO and camera backends in the guest, chroote
 KERNEL_GUEST_ROOT="$rootfs" KERNEL_GUEST_BINDS="$root" \
   "$root/tests/kernel/run.sh" "$build/tests/kernel_tests" "$cache" "$build/tests/work/kernel" \
   "${TRIXIE_KERNEL_FILTER:-GpioSim.*:Vimc.*:Vivid.*}" 600 || rc=1
-kernel_done=$SECONDS
-echo "run: trixie kernel tests took $((kernel_done - tests_done)) s"
+cpu; kernel_done=$SECONDS kernel_cpu=$CPU
+echo "run: trixie kernel tests took $((kernel_done - tests_done)) s (CPU $((kernel_cpu - tests_cpu)) s)"
 
 echo "trixie: the .deb, installed in the root with its trixie dependencies, then avatarbooth check"
 in_root "set -e
@@ -82,7 +91,8 @@ in_root "set -e
   DEBIAN_FRONTEND=noninteractive apt-get purge -y -q avatarbooth >/dev/null
   echo \"trixie: avatarbooth check exit code \$check\"
   exit \$check" || rc=1
-echo "run: trixie package took $((SECONDS - kernel_done)) s"
-echo "trixie: stage took $((SECONDS - start)) s (root $((root_done - start)) s, build $((build_done - root_done)) s," \
+cpu
+echo "run: trixie package took $((SECONDS - kernel_done)) s (CPU $((CPU - kernel_cpu)) s)"
+echo "trixie: stage took $((SECONDS - start)) s, CPU $CPU s (root $((root_done - start)) s, build $((build_done - root_done)) s," \
      "tests $((tests_done - build_done)) s, kernel tests $((kernel_done - tests_done)) s, package $((SECONDS - kernel_done)) s; exit $rc)"
 exit "$rc"
