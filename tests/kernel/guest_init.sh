@@ -26,7 +26,7 @@ if [ -n "$GR" ]; then
   mount -t proc proc $R/proc; mount -t sysfs sys $R/sys; mount -t devtmpfs dev $R/dev
   mount -t devpts devpts $R/dev/pts 2>/dev/null; mount -t tmpfs tmp $R/tmp; mount -t tmpfs run $R/run
   mount -t debugfs debugfs $R/sys/kernel/debug 2>/dev/null
-  for d in $(echo "$GB" | tr , ' '); do mount -o bind "/host$d" "$R$d"; done
+  for d in $(echo "$GB" | tr , ' '); do mkdir -p "$R$d" 2>/dev/null; mount -o bind "/host$d" "$R$d"; done
   mount -o bind /host$WD $R$WD
 fi
 echo "[init] guest shell at uptime $(cut -d' ' -f1 /proc/uptime)s"

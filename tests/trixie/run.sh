@@ -31,7 +31,9 @@ in_root() {
     set -e
     R=$1; src=$2; cmd=$3
     mount -t proc proc "$R/proc"; mount --rbind /sys "$R/sys"; mount --rbind /dev "$R/dev"
-    mount -t tmpfs tmp "$R/tmp"; mount -t tmpfs run "$R/run"; mount --bind "$src" "$R$src"
+    mount -t tmpfs tmp "$R/tmp"; mount -t tmpfs run "$R/run"
+    mkdir -p "$R$src"  # again: a checkout under /tmp (a clone made to try CI) is under the tmpfs just mounted
+    mount --bind "$src" "$R$src"
     exec chroot "$R" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root TERM=dumb LANG=C.UTF-8 \
       CI="${CI:-}" EGL_PLATFORM=surfaceless bash -c "cd \"$src\" && $cmd"
   ' in_root "$rootfs" "$root" "$1"
