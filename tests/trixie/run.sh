@@ -24,19 +24,24 @@ jobs="$(nproc)"
 exclude="${TRIXIE_CTEST_EXCLUDE:-ReportInChromium|^SharePage\.}"
 if [ "$(id -u)" -ne 0 ]; then echo "trixie: run as root (chroot, mounts, mmdebstrap)" >&2; exit 1; fi
 
+shared=""
+[ -d "$root/../shared" ] && shared="$(readlink -f "$root/../shared")"
+
 # Runs a shell command inside the root, in the checkout, with the environment a CI shell would have.
 in_root() {
   mkdir -p "$rootfs$root"
   unshare --mount --propagation private bash -c '
     set -e
-    R=$1; src=$2; cmd=$3
+    R=$1; src=$2; cmd=$3; shared=$4
     mount -t proc proc "$R/proc"; mount --rbind /sys "$R/sys"; mount --rbind /dev "$R/dev"
     mount -t tmpfs tmp "$R/tmp"; mount -t tmpfs run "$R/run"
     mkdir -p "$R$src"  # again: a checkout under /tmp (a clone made to try CI) is under the tmpfs just mounted
     mount --bind "$src" "$R$src"
+    # The sample data beside the checkout (../shared/data), read-only, for the e2e tests that use it.
+    if [ -n "$shared" ]; then mkdir -p "$R$shared"; mount --bind "$shared" "$R$shared"; mount -o remount,bind,ro "$R$shared"; fi
     exec chroot "$R" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root TERM=dumb LANG=C.UTF-8 \
       CI="${CI:-}" EGL_PLATFORM=surfaceless bash -c "cd \"$src\" && $cmd"
-  ' in_root "$rootfs" "$root" "$1"
+  ' in_root "$rootfs" "$root" "$1" "$shared"
 }
 
 # CPU seconds (user + system) of every child process waited for so far: a phase's CPU time next to its wall time
