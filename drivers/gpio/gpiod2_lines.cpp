@@ -238,7 +238,7 @@ public:
 
     std::vector<bool> levels() override {
         std::vector<gpiod_line_value> values(offsets_.size(), GPIOD_LINE_VALUE_ERROR);
-        if (gpiod_line_request_get_values(request_.get(), values.data()) != 0)
+        if (gpiod_line_request_get_values_subset(request_.get(), offsets_.size(), offsets_.data(), values.data()) != 0)
             throw BoothError(ErrorKind::Device, "GPIO " + chip_.name(),
                              std::string("cannot read the lines: ") + std::strerror(errno));
         std::vector<bool> out;

@@ -177,6 +177,22 @@ TEST_F(GpioSim, ALineAlreadyInUseIsAClearDeviceErrorNamingItsUser) {
     }
 }
 
+TEST_F(GpioSim, AButtonHeldWhenTheBoardOpensIsDownAndTheOtherIsNot) {
+    // gpio-sim applies a requested bias as its pull, which would lift the held line: the lines are taken as they are
+    // (bias "as-is", as with external pull-ups).
+    for (auto& b : settings_.buttons) b.bias = LineBias::AsIs;
+    ASSERT_TRUE(pull(1, false));  // retake held down while the booth starts
+    SteadyClock clock;
+    ButtonBoard board = openButtonBoard(settings_, clock);
+    EXPECT_TRUE(board.buttons->isDown("retake"));
+    EXPECT_FALSE(board.buttons->isDown("start"));
+    ASSERT_TRUE(pull(1, true));
+    const auto events = drain(*board.buttons);
+    ASSERT_EQ(events.size(), 1u) << describe(events);
+    EXPECT_EQ(events[0].button, "retake");
+    EXPECT_EQ(events[0].action, ButtonAction::Release);
+}
+
 TEST_F(GpioSim, TheChipOpensByPathNameAndNumberAsByLabel) {
     const std::string number = chip_.substr(std::string("gpiochip").size());
     for (const std::string& name : {"/dev/" + chip_, chip_, number}) {
