@@ -14,6 +14,7 @@
 #include "common/backend_table.h"
 #include "drivers/camera/camera_factory.h"
 #include "drivers/display/display_backends.h"
+#include "drivers/display/display_factory.h"
 #include "drivers/gpio/button_backends.h"
 #include "drivers/gpio/gpiod_lines.h"
 #include "fit/face/landmarks68.h"
@@ -214,6 +215,18 @@ std::string drmConnectors() {
 
 void checkDisplay(const DisplaySettings& settings, Report& report) {
     if (settings.backend != "headless") report.ok("display", "DRM connectors: " + drmConnectors());
+    std::string connectors;
+    if (displayWaitsForScreen(settings, &connectors)) {
+        // A board whose screen is off or unplugged: the booth starts without it and shows its screens once one is
+        // connected (createDisplay). Not a FAIL (the booth runs) nor "would run headless" (it would not).
+        for (const DisplayBackend& b : displayBackends()) {
+            const BackendProbe probe = b.probe(settings);
+            report.ok("display", std::string(b.name) + (probe.usable ? ": " : ": not usable here: ") + probe.text);
+        }
+        report.warn("display", settings.backend + ": kms, waiting for a screen (" + connectors +
+                                   "): the booth starts without one and shows its screens once one is connected");
+        return;
+    }
     checkBackends("display", "display.backend", displayBackends(), settings, "headless", report);
 }
 

@@ -450,7 +450,8 @@ void addButtonsKeys(std::vector<ConfigKey>& k) {
 void addDisplayKeys(std::vector<ConfigKey>& k) {
     // [display]
     k.push_back(backendChoice("display", FIELD(display.backend), kDisplayBackendNames,
-                              "KMS when a screen is connected, else a window when $DISPLAY is set, else headless"));
+                              "KMS when a screen is connected, else a window when $DISPLAY is set, else KMS waiting "
+                              "for a screen when a DRM device has a connector, else headless"));
     k.push_back(integer("display", "rotation", FIELD(display.rotation), 0, 270,
                         "Degrees the picture is turned clockwise for the panel (portrait panels: 90 or 270).", 90));
     k.push_back(integer("display", "width", FIELD(display.width), 64, 8192,

@@ -101,6 +101,7 @@ private:
         spdlog::debug("start-up: {} after {:.3f} s", what, Seconds(std::chrono::steady_clock::now() - startup_).count());
     }
     void pollCamera(FlowTime now);
+    void watchDisplay();
     void startFitWhenFree();
     void handle(const KioskMessage& message, FlowTime now);
     void execute(const FlowCommand& command, FlowTime now);
@@ -119,7 +120,8 @@ private:
     // Devices (the display first, so that whatever goes wrong later can be shown).
     OpenedDisplay opened_;
     Display& display_;
-    ScreenRenderer screens_;
+    // Made again when the screen comes back with another size (layOutForDisplay).
+    std::unique_ptr<ScreenRenderer> screens_;
     std::shared_ptr<SimCameraControls> simControls_;
     std::unique_ptr<ReopeningCamera> camera_;
     SteadyClock clock_;
@@ -156,6 +158,7 @@ private:
     std::uint64_t fitJob_ = 0;  // the fit the visitor waits for; any other's result is dropped
     bool fitWanted_ = false;    // StartFit received, waiting for the preview analysis to let go of the detector
     std::string cameraProblem_;
+    cv::Size displaySizeSeen_;  // the display's size when last looked at (a new one is laid out once)
     Hint lastHint_ = Hint::None;
     RetentionReport lastRetention_, lastFreed_;  // the last retention run, and the operator's last "free disk"
     int leftoversRemoved_ = 0;                   // by the last RemoveLeftovers
@@ -173,11 +176,11 @@ private:
 Kiosk::Kiosk(const BoothConfig& config, const KioskOptions& options, SteadyClockTime startup)
     : config_(config), options_(options), startup_(startup), opened_(createDisplay(config.display)),
       display_(*opened_.display),
-      screens_([&] {
+      screens_(std::make_unique<ScreenRenderer>([&] {
           ScreenSettings s = config.screen;
           s.size = display_.size();
           return s;
-      }()),
+      }())),
       simControls_(options.simControls ? options.simControls : std::make_shared<SimCameraControls>()),
       camera_(openReopeningCamera(config.camera, CameraEnvironment{simControls_, nullptr})),
       board_(openButtonBoard(config.buttons, clock_)), lamps_(*board_.lamps),
@@ -237,6 +240,7 @@ KioskReport Kiosk::run() {
         lamps_.update(clock_.now());
         step.mark("flow");
 
+        watchDisplay();  // before drawing: a new layout replaces the image the last screen was drawn into
         const ScreenModel& screen = flow_.screen();
         KioskFigures::Frame timing{screen.id, std::chrono::steady_clock::now(), {}, {}, {}, false, false};
         const cv::Mat& drawn = drawScreen(screen, timing);
@@ -309,6 +313,29 @@ void Kiosk::pollCamera(FlowTime now) {
         spdlog::debug("preview: {}", e.what());
     }
     if (!lastPreview_.empty() && !fitWanted_) previews_.offer(*previewFor_, lastPreview_, now);
+}
+
+// The screen coming back with another size (a new monitor, or the first one after waiting at the configured size):
+// the screens are laid out for it once. Its loss and return are ReopeningDisplay's to log; while it is away the
+// frames presented are dropped and everything else goes on.
+void Kiosk::watchDisplay() {
+    const cv::Size size = display_.size();
+    if (displaySizeSeen_.empty()) displaySizeSeen_ = screens_->settings().size;
+    if (size == displaySizeSeen_) return;
+    displaySizeSeen_ = size;
+    const cv::Size before = screens_->settings().size;
+    if (size == before) return;
+    ScreenSettings settings = screens_->settings();
+    settings.size = size;
+    try {
+        screens_ = std::make_unique<ScreenRenderer>(std::move(settings));
+        spdlog::info("the screen is now {}x{} (was {}x{}): the screens are laid out for it", size.width, size.height,
+                     before.width, before.height);
+    } catch (const BoothError& e) {
+        // A screen the layout cannot use (under 320x240) keeps the old layout, scaled by the display to fit.
+        spdlog::warn("the screen is now {}x{}, but the screens cannot be laid out for it ({}): they are drawn at {}x{} "
+                     "and scaled to fit", size.width, size.height, e.what(), before.width, before.height);
+    }
 }
 
 // The fit starts once the model is there and the preview analysis has let go of the detector.
@@ -541,10 +568,10 @@ const cv::Mat& Kiosk::drawScreen(const ScreenModel& screen, KioskFigures::Frame&
     if (screen.id == ScreenId::Reveal || screen.id == ScreenId::Attract) {
         // Each style rendered at the size it is shown (no rescaling), and only when its pose changes.
         std::vector<int> sizes;
-        for (const cv::Rect& box : screens_.avatarImageBoxes(screen.id, static_cast<int>(config_.reveal.styles.size())))
+        for (const cv::Rect& box : screens_->avatarImageBoxes(screen.id, static_cast<int>(config_.reveal.styles.size())))
             sizes.push_back(std::max(64, std::min(box.width, box.height)));
         StyleImages images;
-        styles_.fill(images, screen.id == ScreenId::Reveal, screen.sinceEntered, sizes, screens_.layout().stage.size());
+        styles_.fill(images, screen.id == ScreenId::Reveal, screen.sinceEntered, sizes, screens_->layout().stage.size());
         inputs.avatars = std::move(images.avatars);
         inputs.stage = std::move(images.stage);
         // One version for every image shown: the screen is not composed again while none has changed.
@@ -569,8 +596,9 @@ const cv::Mat& Kiosk::drawScreen(const ScreenModel& screen, KioskFigures::Frame&
         inputs.operatorInfo.lastFreed = lastFreed_;
         inputs.operatorInfo.printer = printerNews_;
         inputs.operatorInfo.printerProblem = printerProblem_;
+        if (opened_.reopening) inputs.operatorInfo.screenRecoveries = opened_.reopening->status().recoveries;
     }
-    const cv::Mat& drawn = screens_.draw(screen, inputs);
+    const cv::Mat& drawn = screens_->draw(screen, inputs);
     timing.composeEnd = std::chrono::steady_clock::now();
     if (!ready_) startupStep("first screen composed");
     return drawn;

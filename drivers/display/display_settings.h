@@ -9,7 +9,8 @@ namespace avatarbooth {
 struct DisplaySettings {
     // "kms" (EGL on GBM/KMS: the kiosk, no X or Wayland), "window" (EGL in an X11 window, for development),
     // "headless" (no screen), or "auto": kms when a DRM device has a connected screen, else window when $DISPLAY
-    // is set, else headless (createDisplay says which and why).
+    // is set, else kms waiting for a screen when a DRM device has a connector (a board whose monitor is off), else
+    // headless (createDisplay says which and why). A kms screen lost later is waited for (ReopeningDisplay).
     std::string backend = "auto";
     // Degrees the image is turned clockwise on its way to the panel: 0, 90, 180 or 270. A landscape panel mounted
     // in portrait takes 90 or 270, and the kiosk then composes portrait frames (Display::size()).

@@ -436,6 +436,33 @@ TEST(ScreensPixels, OperatorMenuShowsThePrintersNewsRedWhenItIsAProblem) {
     EXPECT_GT(red(problem), 500) << "a problem is drawn in red";
 }
 
+// A screen that came back after going dark (ReopeningDisplay's recoveries) is counted on the operator menu, under
+// the printer's line, and the five status lines stay clear of the help line at the bottom.
+TEST(ScreensPixels, OperatorMenuCountsScreenRecoveriesAboveTheHelpLine) {
+    ScreenRenderer& r = renderer(Language::English, {1280, 720});
+    ScreenModel m;
+    m.id = ScreenId::OperatorMenu;
+    m.menuPage = OperatorPage::Menu;
+    ScreenInputs in;
+    in.operatorInfo.printer = "queue photo: idle, accepting jobs";
+    const cv::Mat before = r.draw(m, in).clone();
+    in.operatorInfo.screenRecoveries = 2;
+    const cv::Mat counted = r.draw(m, in).clone();
+    cv::Mat diff;
+    cv::absdiff(before, counted, diff);
+    cv::Mat changed;
+    cv::cvtColor(diff, changed, cv::COLOR_BGR2GRAY);
+    EXPECT_GT(cv::countNonZero(changed > 0), 500) << "the screen's line is drawn";
+    // Nothing moved into the help line's band (the bottom 80 px at 1280x720, where it is drawn).
+    const cv::Rect help(0, 720 - 80, 1280, 80);
+    EXPECT_EQ(cv::countNonZero(changed(help) > 0), 0) << "the status lines run into the help line";
+    // Every status line's pixels stay above it.
+    cv::Mat text;
+    cv::inRange(counted, cv::Scalar(100, 100, 100), cv::Scalar(255, 255, 255), text);
+    const cv::Rect gap(0, 720 - 80 - 4, 1280, 4);
+    EXPECT_EQ(cv::countNonZero(text(gap)), 0) << "a status line reaches the help line's band";
+}
+
 TEST(ScreensPixels, AvatarAlphaIsComposited) {
     ScreenModel m;
     m.id = ScreenId::Reveal;

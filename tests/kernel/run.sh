@@ -43,9 +43,12 @@ accel="-accel tcg,thread=multi -cpu max"
 rc=0
 # -nic none: the tests need no network. panic=-1 and -no-reboot turn a guest crash into qemu exiting.
 # debug-threads: the vCPU threads are named ("CPU 0/TCG", ... one per vCPU: multi-threaded TCG) for top -H.
-timeout -k 10 "$limit" qemu-system-x86_64 $accel -name avatarbooth-kernel,debug-threads=on -m 1024 -smp "$(nproc)" -nographic -no-reboot -nic none \
+# video=: vkms's screen runs at the booth's small test size (vkms itself prefers 1024x768), as a Pi's cmdline.txt
+# chooses a mode; the kernel marks it USERDEF and KmsDisplay takes it. virtio-gpu-pci: a display device the tests
+# can take away under an open screen (PCI removal), which vkms cannot be.
+timeout -k 10 "$limit" qemu-system-x86_64 $accel -name avatarbooth-kernel,debug-threads=on -m 1024 -smp "$(nproc)" -nographic -no-reboot -nic none -device virtio-gpu-pci \
   -kernel "$kdir/vmlinuz" -initrd "$kdir/initrd.img" \
-  -append "console=ttyS0 loglevel=4 panic=-1 edd=off rdinit=/init avatarbooth_kernel_guest=1 wdir=$work kroot=$kdir/kroot gscript=$work/guest.sh${keeptmp:+ keeptmp=$keeptmp}$groot" \
+  -append "console=ttyS0 loglevel=4 panic=-1 edd=off rdinit=/init video=Virtual-1:640x360@60 avatarbooth_kernel_guest=1 wdir=$work kroot=$kdir/kroot gscript=$work/guest.sh${keeptmp:+ keeptmp=$keeptmp}$groot" \
   -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap \
   -virtfs local,path="$work",mount_tag=work,security_model=none,multidevs=remap < /dev/null || rc=$?
 if [ "$rc" -ne 0 ]; then echo "kernel tests: qemu failed or timed out after ${limit} s (exit $rc)"; exit 1; fi

@@ -719,18 +719,25 @@ void ScreenRenderer::operatorMenu(const ScreenModel& m, const ScreenInputs& in) 
             y += rowH;
         }
         y += rowH / 2;
-        const std::string status[] = {
-            str(m.cameraAvailable ? "operator.camera_ok" : "operator.camera_lost"),
-            strings_.format(settings_.language, "operator.sessions", {{"count", std::to_string(info.sessionsStored)}}),
-            strings_.format(settings_.language, "operator.free", {{"free", formatBytes(info.freeBytes)}})};
-        for (const auto& s : status) {
-            drawText(s, {margin, y, W - 2 * margin, static_cast<int>(rowH * 0.7)}, static_cast<int>(30 * u), kGrey);
-            y += static_cast<int>(rowH * 0.7);
-        }
+        // One line each: the camera, the sessions, the disk, the printer (when on), the screen (when it came back
+        // after going dark: a loose cable, a monitor on a timer; the operator learns of it only here and in the log,
+        // since the booth went on without it). Five lines are set closer, to stay above the help line.
+        std::vector<std::pair<std::string, cv::Scalar>> status = {
+            {str(m.cameraAvailable ? "operator.camera_ok" : "operator.camera_lost"), kGrey},
+            {strings_.format(settings_.language, "operator.sessions", {{"count", std::to_string(info.sessionsStored)}}), kGrey},
+            {strings_.format(settings_.language, "operator.free", {{"free", formatBytes(info.freeBytes)}}), kGrey}};
         if (!info.printer.empty())
-            drawText(strings_.format(settings_.language, "operator.printer", {{"state", info.printer}}),
-                     {margin, y, W - 2 * margin, static_cast<int>(rowH * 0.7)}, static_cast<int>(30 * u),
-                     info.printerProblem ? kRetakeRed : kGrey);
+            status.emplace_back(strings_.format(settings_.language, "operator.printer", {{"state", info.printer}}),
+                                info.printerProblem ? kRetakeRed : kGrey);
+        if (info.screenRecoveries > 0)
+            status.emplace_back(strings_.format(settings_.language, "operator.screen_back",
+                                                {{"count", std::to_string(info.screenRecoveries)}}),
+                                kGrey);
+        const int lineH = static_cast<int>(rowH * (status.size() > 4 ? 0.6 : 0.7));
+        for (const auto& [text, colour] : status) {
+            drawText(text, {margin, y, W - 2 * margin, lineH}, static_cast<int>(30 * u), colour);
+            y += lineH;
+        }
         drawText(str("operator.help"), {0, H - static_cast<int>(80 * u), W, static_cast<int>(60 * u)},
                  static_cast<int>(30 * u), kSoftWhite);
         return;

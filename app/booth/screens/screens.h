@@ -48,6 +48,7 @@ struct OperatorInfo {
     RetentionReport lastFreed;  // what the last FreeDisk did
     std::string printer;        // the printer's last news ([print] on; "" = printing off)
     bool printerProblem = false;  // ... and whether the operator has to act on it (shown in red)
+    int screenRecoveries = 0;     // times the screen came back after going away (shown when not 0)
 };
 
 struct ScreenInputs {

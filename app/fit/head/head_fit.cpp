@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <set>
@@ -139,6 +140,68 @@ bool onSmoothOutline(const std::string& name) { return name != "nose_tip" && nam
 // A contour ray's crossing (METHODS §1 step 4), as against a landmark: by the name ViewTargets gives it.
 bool isContourTarget(const std::string& name) { return name.find("_contour_") != std::string::npos; }
 
+// A point of the face's profile (HeadFitOptions::faceProfile), also by its name.
+constexpr std::string_view kFaceProfilePrefix = "side_profile_";
+bool isFaceProfileTarget(const std::string& name) { return name.rfind(kFaceProfilePrefix, 0) == 0; }
+
+// The midline vertices that lie on the base head's side outline between the glabella and the throat, top to
+// bottom: the head's side silhouette (drawn at 0.5 mm) holds no point 1.5 mm outside them along their normal, so
+// the inner lips and what the nose hides drop out.
+std::vector<std::uint32_t> faceProfileVertices(const BaseHead& base) {
+    const Mesh& m = base.mesh;
+    const auto top = base.sideFeatures.find("glabella"), bottom = base.sideFeatures.find("throat");
+    if (top == base.sideFeatures.end() || bottom == base.sideFeatures.end()) return {};
+    const double yTop = m.positions[top->second].y, yBottom = m.positions[bottom->second].y;
+    glm::dvec3 lo, hi;
+    m.bounds(lo, hi);
+    constexpr double kMmPerPx = 0.5;
+    const auto px = [&](const glm::dvec3& p) { return cv::Point2d((p.z - lo.z) / kMmPerPx + 4.0, (hi.y - p.y) / kMmPerPx + 4.0); };
+    cv::Mat mask = cv::Mat::zeros(static_cast<int>((hi.y - lo.y) / kMmPerPx) + 8, static_cast<int>((hi.z - lo.z) / kMmPerPx) + 8, CV_8U);
+    for (const auto& t : m.triangles) {
+        const std::array<cv::Point, 3> c = {px(m.positions[t[0]]), px(m.positions[t[1]]), px(m.positions[t[2]])};
+        cv::fillConvexPoly(mask, c.data(), 3, cv::Scalar(255));
+    }
+    std::vector<bool> rigid(m.positions.size(), false);
+    for (const auto& part : base.rigidParts)
+        for (const auto v : part) rigid[v] = true;
+    const auto normals = m.vertexNormals();
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t v = 0; v < m.positions.size(); ++v) {
+        const glm::dvec3& p = m.positions[v];
+        if (rigid[v] || std::abs(p.x) > 1e-3 || p.z < base.earHoleCentre.z || p.y > yTop || p.y < yBottom) continue;
+        const glm::dvec2 n = projectToView(normals[v], View::Side);
+        if (glm::length(n) < 0.5) continue;
+        const glm::dvec2 out2 = projectToView(p, View::Side) + 1.5 * glm::normalize(n);
+        const cv::Point2d q = px(glm::dvec3(0.0, out2.y, out2.x));
+        const int x = static_cast<int>(std::lround(q.x)), y = static_cast<int>(std::lround(q.y));
+        if (x < 0 || y < 0 || x >= mask.cols || y >= mask.rows || mask.at<unsigned char>(y, x) == 0) out.push_back(v);
+    }
+    std::sort(out.begin(), out.end(), [&](std::uint32_t a, std::uint32_t b) { return m.positions[a].y > m.positions[b].y; });
+    return out;
+}
+
+// Where the outline of `mask` crosses the segment through `at` along `dir` (pixels, unit length) within `reach`
+// pixels either way: the crossing from inside to outside (going along dir) nearest `at`.
+std::optional<cv::Point2d> outlineAlongNormal(const cv::Mat& mask, const cv::Point2d& at, const cv::Point2d& dir, double reach) {
+    const auto inside = [&](const cv::Point2d& p) {
+        const int x = static_cast<int>(std::lround(p.x)), y = static_cast<int>(std::lround(p.y));
+        return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<unsigned char>(y, x) != 0;
+    };
+    std::optional<cv::Point2d> best;
+    double bestDistance = 1e300;
+    bool wasInside = inside(at - dir * reach);
+    for (double t = -reach + 0.5; t <= reach; t += 0.5) {
+        const cv::Point2d p = at + dir * t;
+        const bool in = inside(p);
+        if (wasInside && !in && std::abs(t) < bestDistance) {
+            bestDistance = std::abs(t);
+            best = at + dir * (t - 0.25);
+        }
+        wasInside = in;
+    }
+    return best;
+}
+
 }  // namespace
 
 glm::dvec2 PhotoFrame::toHead(const cv::Point2d& px) const {
@@ -232,6 +295,7 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     // on the ear hole's estimate (about 5 % of the head's height off, more under a bun of hair), which the profile's
     // face points correct.
     glm::dvec3 frameShift(0.0), frameAnchor(0.0);
+    const std::vector<std::uint32_t> profileVertices = options.faceProfile ? faceProfileVertices(base) : std::vector<std::uint32_t>{};
     ViewTargets frontT(View::Front), sideT(View::Side);
     for (int round = 0;; ++round) {
         frontT = ViewTargets(View::Front);
@@ -331,14 +395,29 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
             addSideContour("side_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, sideCanonical.toHead(hit));
         }
 
+        if (options.faceProfile) {
+            for (const auto v : profileVertices) {
+                const glm::dvec2 n = projectToView(scaledNormals[v], View::Side);
+                if (glm::length(n) < 1e-6) continue;
+                const glm::dvec2 n2 = glm::normalize(n);
+                const cv::Point2d at = sideCanonical.toPixel(projectToView(scaled.positions[v], View::Side));
+                const auto hit = outlineAlongNormal(sideMask, at, cv::Point2d(n2.x, -n2.y),
+                                                    options.faceProfileSearchMm / sideCanonical.mmPerPixel);
+                if (!hit) continue;
+                fit.sideRays.emplace_back(mirrorPoint(at, sideWidth, mirror), mirrorPoint(*hit, sideWidth, mirror));
+                addSideContour(std::string(kFaceProfilePrefix) + std::to_string(v), v, sideCanonical.toHead(*hit));
+            }
+        }
+
         if (!base.modifiers || round == options.modifierRounds) break;
         std::vector<ModifierTarget> targets;
         for (const ViewTargets* view : {&frontT, &sideT})
             for (std::size_t k = 0; k < view->vertices.size(); ++k) {
                 // The outline rays meet hair as often as skin: they shape the head less than the landmarks do.
-                const bool contour = isContourTarget(view->targets[k].first);
+                const bool profile = isFaceProfileTarget(view->targets[k].first);
+                const bool contour = profile || isContourTarget(view->targets[k].first);
                 const bool onOutline = glm::dot(view->outlineNormals[k], view->outlineNormals[k]) > 0.0;
-                const double weight = contour ? options.contourWeight : 1.0;
+                const double weight = profile ? options.faceProfileWeight : contour ? options.contourWeight : 1.0;
                 // A ray's crossing says nothing about where along the outline the vertex lies; a profile landmark
                 // says a little (outlineTangentWeight).
                 const double along = !onOutline ? weight : contour ? 0.0 : options.outlineTangentWeight * weight;

@@ -43,6 +43,12 @@ struct HeadFitOptions {
     // exact interpolation) when the base head has a modifier basis: a detected landmark is a few pixels off, and the
     // warp that passes through each one exactly carries that noise into the face the modifiers had already shaped.
     double landmarkRidge = 3.0;
+    // The face's own profile in the side photo: the midline vertices on the base head's side outline between the
+    // glabella and the throat, each pushed onto the photo's outline along its normal (searched this far either way).
+    // The profile landmarks alone leave the nose's bridge and underside, the lips and the under-chin unmeasured.
+    bool faceProfile = true;
+    double faceProfileWeight = 0.3;
+    double faceProfileSearchMm = 12.0;
 };
 
 HeadFitOptions defaultHeadFitOptions();
