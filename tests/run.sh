@@ -5,6 +5,8 @@
 #
 # With the ci preset (.ci/run) the arm64 stage follows: cross build for the board and the unit tests under
 # qemu-aarch64 (tests/arm64/run.sh). AVATARBOOTH_ARM64=0 leaves it out, AVATARBOOTH_ARM64=1 adds it to other presets.
+# Then the trixie stage: the build and the tests in a Debian 13 root, the kernel tests of the gpiod 2 and
+# libcamera 0.4 builds in the guest, the .deb installed there (tests/trixie/run.sh). AVATARBOOTH_TRIXIE=0/1 likewise.
 # CI's budget is 45 minutes for all of it on a fresh 2-core machine; the README ("Building for the board") has the
 # measured figures of each phase. Each phase prints its time ("run: ... took N s").
 set -euo pipefail
@@ -14,6 +16,7 @@ shift || true
 arm64_default=0
 [ "$preset" = ci ] && arm64_default=1
 arm64="${AVATARBOOTH_ARM64:-$arm64_default}"
+trixie="${AVATARBOOTH_TRIXIE:-$arm64_default}"
 
 start=$SECONDS
 "$root/tests/setup.sh" "$preset"
@@ -22,7 +25,7 @@ echo "run: set-up and native build took $((setup_done - start)) s"
 
 # Headless EGL through Mesa (llvmpipe) needs no display; keep Mesa from looking for one.
 export EGL_PLATFORM=surfaceless
-# No `exit` on failure before the arm64 stage: CI reports both, and fails if either failed.
+# No `exit` on failure before the arm64 and trixie stages: CI reports all, and fails if any failed.
 rc=0
 ctest --preset "$preset" --timeout 900 --parallel "$(nproc)" "$@" || rc=$?
 tests_done=$SECONDS
@@ -31,6 +34,11 @@ echo "run: native tests took $((tests_done - setup_done)) s"
 if [ "$arm64" = 1 ]; then
   "$root/tests/arm64/run.sh" || rc=$?
   echo "run: arm64 stage took $((SECONDS - tests_done)) s"
+fi
+if [ "$trixie" = 1 ]; then
+  trixie_start=$SECONDS
+  "$root/tests/trixie/run.sh" || rc=$?
+  echo "run: trixie stage took $((SECONDS - trixie_start)) s"
 fi
 echo "run: $((SECONDS - start)) s in all (exit $rc)"
 exit "$rc"

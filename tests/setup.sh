@@ -5,18 +5,46 @@
 # Usage: tests/setup.sh [PRESET] [TARGET...]   (default: release; CI uses "ci", which turns warnings into errors)
 # With TARGETs (sim/demo.sh passes avatarbooth) only those are built, and the tests' Debian and npm packages are
 # left out; without, everything is installed and built (the tests, the benchmarks).
+#        tests/setup.sh --print-packages CODENAME   prints the build packages of that Debian release, one a line
+#                                                   (the trixie stage installs them in its Debian 13 root)
+# Debian bookworm (12) and trixie (13) are both supported; the release is read from /etc/os-release.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-preset="${1:-release}"
-shift || true
-targets=("$@")
+print_only=""
+if [ "${1:-}" = --print-packages ]; then
+  print_only=1
+  codename="${2:?usage: tests/setup.sh --print-packages CODENAME}"
+else
+  codename="$(. /etc/os-release && echo "${VERSION_CODENAME:-}")"
+  preset="${1:-release}"
+  shift || true
+  targets=("$@")
+fi
+
+# Names that differ between the releases: the compilers the tests name by version (the fuzz targets' clang, the
+# guest kernel modules' gcc, which must be the one the release's kernel was built with). The libraries' -dev
+# packages keep their names (the t64 renames in trixie are of the runtime packages, which the -dev packages and the
+# .deb's dpkg-shlibdeps dependencies pick up by themselves).
+case "$codename" in
+  bookworm) clang_version=14; kernel_gcc=gcc-12 ;;
+  trixie) clang_version=19; kernel_gcc=gcc-14 ;;
+  *) echo "setup: Debian ${codename:-(unknown)} is not one this project builds on (bookworm, trixie); trying bookworm's names" >&2
+     clang_version=14; kernel_gcc=gcc-12 ;;
+esac
 
 # What building and running the booth needs (sim/demo.sh installs these alone) ...
 packages=(
   build-essential cmake pkg-config git
+  # (CPack's .deb runs dpkg-shlibdeps on the files `file` says are ELF: a minimal trixie system has no `file`)
+  file
   libopencv-dev opencv-data libdlib-dev libdlib-data
+  # (dlib's exported CMake file names libblas.so and liblapack.so, which only these ship; trixie's libdlib-dev does
+  # not pull them in)
+  libblas-dev liblapack-dev
   libtinygltf-dev nlohmann-json3-dev libglm-dev
   libegl-dev libgles-dev libgbm-dev libdrm-dev libegl-mesa0 libgl1-mesa-dri libx11-dev
+  # (CMake 3.31, trixie's, asks FindOpenGL for libOpenGL.so even when only EGL is wanted)
+  libopengl-dev
   libcli11-dev libspdlog-dev libtomlplusplus-dev libsystemd-dev libgpiod-dev libcamera-dev
   libfreetype-dev fonts-dejavu-core fonts-vlgothic
   # image files (app/common/image_codec): libjpeg-turbo, libpng, libexif (orientation), stb_image (BMP)
@@ -43,7 +71,7 @@ test_packages=(
   # the batch report test opens report.html in headless Chromium (driven by puppeteer-core from npm)
   chromium
   # the reliability suite's fuzz targets (tests/fuzz/): clang with its libFuzzer and sanitizer runtimes
-  clang-14 libclang-rt-14-dev
+  "clang-$clang_version" "libclang-rt-$clang_version-dev"
   # the e2e test of the development window runs it under a virtual X server
   xvfb
   # the thanks screen's QR code is read back from its screenshot (zbarimg)
@@ -54,12 +82,18 @@ test_packages=(
   # and Ghostscript) and read the PDF back (pdfinfo, pdftotext, pdftoppm)
   cups-daemon cups-client printer-driver-cups-pdf poppler-utils
   # the `kernel` tests (tests/kernel/): qemu boots Debian's kernel; busybox/cpio/kmod make its initramfs and
-  # module tree (modules built with gcc-12/make); v4l-utils, udev, libcamera-ipa/-tools are used inside the guest
-  qemu-system-x86 busybox-static cpio kmod xz-utils make gcc-12 libc6-dev v4l-utils udev libcamera-ipa libcamera-tools
+  # module tree (modules built with the kernel's gcc and make); v4l-utils, udev, libcamera-ipa/-tools are used inside
+  # the guest
+  qemu-system-x86 busybox-static cpio kmod xz-utils make "$kernel_gcc" libc6-dev v4l-utils udev libcamera-ipa
+  libcamera-tools
   # the arm64 stage (tests/arm64/, CI runs it after the native tests): cross g++, qemu-user, and mmdebstrap for the
   # sysroot; listed here too so that a fresh machine installs everything in one apt-get run
   g++-aarch64-linux-gnu qemu-user mmdebstrap
 )
+if [ -n "$print_only" ]; then
+  printf '%s\n' "${packages[@]}"
+  exit 0
+fi
 ((${#targets[@]})) || packages+=("${test_packages[@]}")
 missing=()
 for p in "${packages[@]}"; do

@@ -25,6 +25,8 @@
 #include "drivers/sound/sound_player.h"
 
 #include <nlohmann/json.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 
 #include <unistd.h>
 
@@ -181,7 +183,7 @@ void checkGpio(const GpioSettings& settings, Report& report) {
         report.fail("gpio", e.what(), ErrorKind::Device);  // the chip went away since the probe
         return;
     }
-    report.ok("gpio", "chip " + chipName);
+    report.ok("gpio", "chip " + chipName + " (" + gpiodLibraryVersion() + ")");
     for (std::size_t i = 0; i < lines.size(); ++i) {
         const GpioLineStatus& s = lines[i];
         const std::string line = labels[i] + ": line " + std::to_string(s.offset) + (s.name.empty() ? "" : " (" + s.name + ")");
@@ -378,6 +380,14 @@ void registerCheckCommand(CLI::App& app) {
                     std::string("Configuration file to check (default: ") + kInstalledConfig + " when it exists)");
     cmd->add_flag("--json", o->json, "Print the results as JSON (for scripts)");
     cmd->callback([o] {
+        if (o->json) {
+            // Stdout is the report's, which a script parses: what the libraries log while the checks run (libcamera
+            // 0.4 complains through spdlog about a machine without dma-buf heaps) goes to stderr instead.
+            const auto level = spdlog::default_logger()->level();
+            auto logger = spdlog::stderr_color_mt("check");
+            logger->set_level(level);
+            spdlog::set_default_logger(logger);
+        }
         Report report;
         const BoothConfig config = checkConfig(o->config, report);
         checkCameras(config.camera, report);

@@ -12,6 +12,8 @@
 #include <functional>
 #include <mutex>
 #include <thread>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace avatarbooth {
@@ -22,21 +24,31 @@ namespace {
 // accepting thread waits here, so further connections wait in the kernel's listen backlog (and beyond it are
 // refused by the kernel), never in the booth's memory.
 class BoundedPool : public httplib::TaskQueue {
+    // cpp-httplib 0.11 (bookworm) has `void enqueue`; later ones (trixie's 0.18) return whether the task was taken,
+    // a false making the server close the connection. This pool takes every task (it waits for room instead).
+    using EnqueueResult = decltype(std::declval<httplib::TaskQueue&>().enqueue(std::function<void()>{}));
+    template <typename Result = EnqueueResult>
+    static Result taken() {
+        if constexpr (std::is_void_v<Result>) return;
+        else return true;
+    }
+
 public:
     BoundedPool(std::size_t workers, std::size_t queue) : limit_(queue) {
         for (std::size_t i = 0; i < workers; ++i) threads_.emplace_back([this] { work(); });
     }
 
-    void enqueue(std::function<void()> fn) override {
+    EnqueueResult enqueue(std::function<void()> fn) override {
         std::unique_lock lock(mutex_);
         spaceFree_.wait(lock, [&] { return jobs_.size() < limit_ || shutdown_; });
         if (shutdown_) {
             lock.unlock();
             fn();  // the server is stopping: the connection is answered (and closed) by this thread
-            return;
+            return taken();
         }
         jobs_.push_back(std::move(fn));
         jobReady_.notify_one();
+        return taken();
     }
 
     void shutdown() override {

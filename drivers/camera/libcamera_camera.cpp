@@ -3,6 +3,7 @@
 #include "drivers/camera/libcamera_camera.h"
 
 #include "drivers/camera/frame_conversion.h"
+#include "drivers/camera/libcamera_compat.h"
 #include "drivers/camera/libcamera_log.h"
 
 #include <libcamera/libcamera.h>
@@ -142,8 +143,11 @@ struct LibcameraCamera::Impl {
         choosePixelFormat(stream);
         if (width > 0 && height > 0) stream.size = lc::Size(static_cast<unsigned>(width), static_cast<unsigned>(height));
         if (buffers > 0) stream.bufferCount = static_cast<unsigned>(buffers);
+        libcamera_compat::uprightImages(*config);
         if (config->validate() == lc::CameraConfiguration::Invalid)
             throw BoothError(ErrorKind::Device, id, "refused the stream configuration " + stream.toString());
+        spdlog::debug("camera {}: {} {}, orientation {}", id, role == lc::StreamRole::Viewfinder ? "viewfinder" : "still",
+                      stream.toString(), libcamera_compat::orientationName(*config));
         if (!rawFormatFromLibcamera(stream.pixelFormat.toString()))
             throw BoothError(ErrorKind::Device, id, "offers only the pixel format " + stream.pixelFormat.toString() + ", which the booth cannot convert");
         return config;

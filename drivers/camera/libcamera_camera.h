@@ -1,8 +1,8 @@
 // The libcamera backend (Raspberry Pi CSI cameras, and UVC cameras through libcamera): a viewfinder stream for
 // the preview and a still-capture configuration for photos. libcamera types stay out of this header.
 //
-// Written against Debian's libcamera 0.0.3 with the API that newer releases keep (no CameraManager::get(dev_t),
-// no CameraConfiguration::transform, no AeLocked).
+// Builds against Debian bookworm's libcamera 0.0.3 and trixie's 0.4 (Raspberry Pi OS trixie: 0.5); what differs
+// between them is in libcamera_compat.h, the rest is API all of them keep.
 #pragma once
 
 #include "drivers/camera/camera.h"

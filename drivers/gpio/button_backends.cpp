@@ -6,6 +6,9 @@
 #include "drivers/gpio/debounced_buttons.h"
 #include "drivers/gpio/gpiod_lines.h"
 
+#include <algorithm>
+#include <chrono>
+
 namespace avatarbooth {
 namespace {
 
@@ -14,6 +17,12 @@ std::vector<std::string> lampNames(const GpioSettings& s) {
     for (const auto& l : s.lamps) out.push_back(l.name);
     return out;
 }
+
+// Where libgpiod can ask the kernel to debounce (2.x), it filters glitches this short (interference on a long
+// button cable) before they reach the software debouncer. Kept short: the kernel reports an edge only once the
+// line has held its level this long, so every press comes this much later, and the booth's rule is a press on its
+// edge (the software debouncer, debounce_ms, takes care of contact bounce without delaying the press).
+constexpr std::chrono::microseconds kKernelGlitchFilter{5000};
 
 BackendProbe probeGpiod(const GpioSettings& s) {
     std::string why;
@@ -30,8 +39,13 @@ OpenedButtons openGpiod(const GpioSettings& settings, Clock&) {
     std::vector<InputLineRequest> inputs;
     std::vector<DebouncedLine> config;
     for (const auto& b : settings.buttons) {
-        inputs.push_back({b.offset, b.bias, b.name + " button"});
-        config.push_back({b.name, debounceFor(settings, b)});
+        const DebounceSettings debounce = debounceFor(settings, b);
+        const auto glitch = gpiodKernelDebounce()
+                                ? std::min(kKernelGlitchFilter,
+                                           std::chrono::duration_cast<std::chrono::microseconds>(debounce.period))
+                                : std::chrono::microseconds{0};
+        inputs.push_back({b.offset, b.bias, b.name + " button", glitch});
+        config.push_back({b.name, debounce});
     }
     out.buttons = std::make_unique<DebouncedButtons>(openGpiodInputLines(settings.chip, inputs, settings.consumer),
                                                      std::move(config));

@@ -1,6 +1,7 @@
-// libgpiod 1.6 backend of the raw GPIO lines: the only file that calls the gpiod API.
+// libgpiod 1.6 backend of the raw GPIO lines (Debian bookworm); gpiod2_lines.cpp is the 2.x one, and
+// drivers/gpio/CMakeLists.txt compiles one of the two, by pkg-config's version.
 //
-// What libgpiod 2.x changes (a gpiod2_lines.cpp beside this one would implement the same three functions):
+// What libgpiod 2.x changes (gpiod2_lines.cpp implements the same functions with it):
 // chips open by path only (gpiod_chip_open; labels come from gpiod_chip_get_info, so lookup by label means
 // scanning /dev/gpiochip*); gpiod_chip_get_line + gpiod_line_request_* are replaced by gpiod_line_settings
 // (direction, edge detection, bias, active-low, and a kernel debounce period) + gpiod_line_config +
@@ -281,5 +282,10 @@ std::vector<GpioLineStatus> gpiodLineStatus(const std::string& chip, const std::
     }
     return out;
 }
+
+std::string gpiodLibraryVersion() { return std::string("libgpiod ") + gpiod_version_string(); }
+
+// The v1 uAPI that 1.6 speaks has no debounce attribute.
+bool gpiodKernelDebounce() { return false; }
 
 }  // namespace avatarbooth

@@ -289,18 +289,26 @@ TEST_F(ShareServerTest, OnlyGetAndHead) {
 TEST_F(ShareServerTest, OversizedRequestsAreRefused) {
     start();
     const std::string page = "/s/" + fresh_.token;
-    // One header line of 64 KiB; 200 small headers; a 20 KiB request line.
+    // One header line of 64 KiB; 80 small headers (over the server's 64: its own 431); 200 small headers (newer
+    // cpp-httplib, trixie's 0.18, refuses more than 100 itself with a 400 before the server sees them); a 20 KiB
+    // request line.
     const RawAnswer longHeader =
         rawRequest(port_, "GET " + page + " HTTP/1.1\r\nHost: x\r\nX-Big: " + std::string(64 * 1024, 'a') + "\r\n\r\n");
     EXPECT_NE(longHeader.status, 200) << longHeader.head;
-    std::string many = "GET " + page + " HTTP/1.1\r\nHost: x\r\n";
-    for (int i = 0; i < 200; ++i) many += "X-H" + std::to_string(i) + ": " + std::string(100, 'b') + "\r\n";
-    const RawAnswer manyHeaders = rawRequest(port_, many + "\r\n");
+    const auto headers = [&](int n) {
+        std::string many = "GET " + page + " HTTP/1.1\r\nHost: x\r\n";
+        for (int i = 0; i < n; ++i) many += "X-H" + std::to_string(i) + ": " + std::string(100, 'b') + "\r\n";
+        return rawRequest(port_, many + "\r\n");
+    };
+    const RawAnswer manyHeaders = headers(80);
     EXPECT_EQ(manyHeaders.status, 431) << manyHeaders.head;
+    const RawAnswer tooManyHeaders = headers(200);
+    EXPECT_TRUE(tooManyHeaders.status == 431 || tooManyHeaders.status == 400) << tooManyHeaders.head;
     const RawAnswer longLine = rawRequest(port_, get(page + "?" + std::string(20 * 1024, 'q')));
     EXPECT_NE(longLine.status, 200) << longLine.head;
-    std::printf("[ figures ] 64 KiB header line -> %d, 200 headers -> %d, 20 KiB request line -> %d (0: closed)\n",
-                longHeader.status, manyHeaders.status, longLine.status);
+    std::printf("[ figures ] 64 KiB header line -> %d, 80 headers -> %d, 200 headers -> %d, 20 KiB request line -> %d "
+                "(0: closed)\n",
+                longHeader.status, manyHeaders.status, tooManyHeaders.status, longLine.status);
     EXPECT_EQ(rawRequest(port_, get(page)).status, 200) << "still serving";
 }
 

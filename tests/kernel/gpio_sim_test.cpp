@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <iostream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -174,6 +175,73 @@ TEST_F(GpioSim, ALineAlreadyInUseIsAClearDeviceErrorNamingItsUser) {
     } catch (const BoothError& e) {
         EXPECT_NE(std::string(e.what()).find("already in use"), std::string::npos) << e.what();
     }
+}
+
+TEST_F(GpioSim, AButtonHeldWhenTheBoardOpensIsDownAndTheOtherIsNot) {
+    // gpio-sim applies a requested bias as its pull, which would lift the held line: the lines are taken as they are
+    // (bias "as-is", as with external pull-ups).
+    for (auto& b : settings_.buttons) b.bias = LineBias::AsIs;
+    ASSERT_TRUE(pull(1, false));  // retake held down while the booth starts
+    SteadyClock clock;
+    ButtonBoard board = openButtonBoard(settings_, clock);
+    EXPECT_TRUE(board.buttons->isDown("retake"));
+    EXPECT_FALSE(board.buttons->isDown("start"));
+    ASSERT_TRUE(pull(1, true));
+    const auto events = drain(*board.buttons);
+    ASSERT_EQ(events.size(), 1u) << describe(events);
+    EXPECT_EQ(events[0].button, "retake");
+    EXPECT_EQ(events[0].action, ButtonAction::Release);
+}
+
+TEST_F(GpioSim, TheChipOpensByPathNameAndNumberAsByLabel) {
+    const std::string number = chip_.substr(std::string("gpiochip").size());
+    for (const std::string& name : {"/dev/" + chip_, chip_, number}) {
+        SCOPED_TRACE(name);
+        settings_.chip = name;
+        SteadyClock clock;
+        ButtonBoard board = openButtonBoard(settings_, clock);
+        EXPECT_NE(board.description.find(std::string("[") + kLabel + "]"), std::string::npos) << board.description;
+    }
+}
+
+TEST_F(GpioSim, ALineTheChipDoesNotHaveIsAClearDeviceError) {
+    try {
+        openGpiodInputLines(kLabel, {{9, LineBias::PullUp, "start button"}}, "avatarbooth-test");
+        FAIL() << "requested line 9 of an 8-line chip";
+    } catch (const BoothError& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Device);
+        EXPECT_NE(std::string(e.where()).find("line 9 (start button)"), std::string::npos) << e.where();
+        EXPECT_NE(std::string(e.what()).find("the chip has 8 lines (0-7)"), std::string::npos) << e.what();
+    }
+}
+
+// libgpiod 2.x asks the kernel to filter glitches on the button lines (a few ms, below the software debounce);
+// 1.6's uAPI cannot, and the kernel then reports no debounce.
+TEST_F(GpioSim, TheKernelDebouncesTheButtonLinesWhereLibgpiodCan) {
+    std::cout << "[ backend  ] " << gpiodLibraryVersion() << ", kernel debounce " << (gpiodKernelDebounce() ? "yes" : "no")
+              << std::endl;
+    SteadyClock clock;
+    ButtonBoard board = openButtonBoard(settings_, clock);
+    std::string chipName;
+    const auto lines = gpiodLineStatus(kLabel, {0, 1, 4}, &chipName);
+    ASSERT_EQ(lines.size(), 3u);
+    const auto expected = gpiodKernelDebounce() ? std::chrono::microseconds(5000) : std::chrono::microseconds(0);
+    for (int i : {0, 1}) {
+        EXPECT_TRUE(lines[i].used);
+        EXPECT_EQ(lines[i].consumer, "avatarbooth-test");
+        EXPECT_EQ(lines[i].kernelDebounce, expected) << "line " << lines[i].offset;
+    }
+    EXPECT_EQ(lines[2].kernelDebounce, std::chrono::microseconds(0)) << "a lamp is an output, never debounced";
+    if (gpiodKernelDebounce()) {
+        EXPECT_NE(board.description.find("kernel debounce 5000 us"), std::string::npos) << board.description;
+    }
+    // A press still arrives as one press and one release through the kernel's filter.
+    ASSERT_TRUE(pull(0, false));
+    std::this_thread::sleep_for(200ms);
+    ASSERT_TRUE(pull(0, true));
+    const auto events = drain(*board.buttons);
+    ASSERT_EQ(events.size(), 2u) << describe(events);
+    EXPECT_EQ(events[0].action, ButtonAction::Press);
 }
 
 }  // namespace

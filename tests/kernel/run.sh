@@ -3,6 +3,9 @@
 # qemu-system-x86_64 (TCG: no KVM, no host modules) with the host's root shared read-only over 9p, and runs the
 # kernel_tests GoogleTest executable inside it against vivid, gpio-sim and vimc. Exit code: the tests'.
 # Usage: tests/kernel/run.sh KERNEL_TESTS_BINARY CACHE_DIR WORK_DIR [GTEST_FILTER] [TIMEOUT_S]
+# KERNEL_GUEST_ROOT=DIR: the guest chroots into DIR (a root of another Debian release that the binary was built in,
+# e.g. tests/trixie/) instead of the host's /, with the host folders KERNEL_GUEST_BINDS names (comma-separated:
+# the checkout, which holds the binary, this cache and the work folder) bound in at their own paths.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 binary=$(readlink -f "${1:?usage: run.sh KERNEL_TESTS_BINARY CACHE_DIR WORK_DIR [GTEST_FILTER] [TIMEOUT_S]}")
@@ -30,6 +33,12 @@ for p in "$binary" "$kdir" "$here" "$work"; do
   case "$p" in /tmp/?*) top=/tmp/$(echo "${p#/tmp/}" | cut -d/ -f1)
     case ",$keeptmp," in *",$top,"*) ;; *) keeptmp=${keeptmp:+$keeptmp,}$top;; esac;; esac
 done
+groot=""
+if [ -n "${KERNEL_GUEST_ROOT:-}" ]; then
+  groot=" groot=$(readlink -f "$KERNEL_GUEST_ROOT") gbind=${KERNEL_GUEST_BINDS:-}"
+  # The guest cannot make mount points in the read-only host root: they are made here.
+  for d in $(echo "${KERNEL_GUEST_BINDS:-}" | tr , ' '); do mkdir -p "$KERNEL_GUEST_ROOT$d"; done
+fi
 accel="-accel tcg,thread=multi -cpu max"
 rc=0
 # -nic none: the tests need no network. panic=-1 and -no-reboot turn a guest crash into qemu exiting.
@@ -39,7 +48,7 @@ rc=0
 # can take away under an open screen (PCI removal), which vkms cannot be.
 timeout -k 10 "$limit" qemu-system-x86_64 $accel -name avatarbooth-kernel,debug-threads=on -m 1024 -smp "$(nproc)" -nographic -no-reboot -nic none -device virtio-gpu-pci \
   -kernel "$kdir/vmlinuz" -initrd "$kdir/initrd.img" \
-  -append "console=ttyS0 loglevel=4 panic=-1 edd=off rdinit=/init video=Virtual-1:640x360@60 avatarbooth_kernel_guest=1 wdir=$work kroot=$kdir/kroot gscript=$work/guest.sh${keeptmp:+ keeptmp=$keeptmp}" \
+  -append "console=ttyS0 loglevel=4 panic=-1 edd=off rdinit=/init video=Virtual-1:640x360@60 avatarbooth_kernel_guest=1 wdir=$work kroot=$kdir/kroot gscript=$work/guest.sh${keeptmp:+ keeptmp=$keeptmp}$groot" \
   -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap \
   -virtfs local,path="$work",mount_tag=work,security_model=none,multidevs=remap < /dev/null || rc=$?
 if [ "$rc" -ne 0 ]; then echo "kernel tests: qemu failed or timed out after ${limit} s (exit $rc)"; exit 1; fi
