@@ -9,6 +9,7 @@
 #include "fit/head/modifier_fit.h"
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <array>
