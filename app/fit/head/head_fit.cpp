@@ -36,6 +36,12 @@ glm::dvec3 meanVertex(const Mesh& mesh, const BaseHead& base, int from, int to) 
     return sum / static_cast<double>(to - from + 1);
 }
 
+// Whether the pixel nearest `p` lies on the silhouette (outside the image: no).
+bool inMask(const cv::Mat& mask, const cv::Point2d& p) {
+    const int x = static_cast<int>(std::lround(p.x)), y = static_cast<int>(std::lround(p.y));
+    return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<unsigned char>(y, x) != 0;
+}
+
 // Walks from `start` along `dir` (pixels) and returns the last pixel inside the mask before it is left; this is
 // where a half-line from the view's centre crosses the head's outline (METHODS §1 step 4).
 cv::Point2d outlineCrossing(const cv::Mat& mask, const cv::Point2d& start, const cv::Point2d& dir, const char* view) {
@@ -45,9 +51,7 @@ cv::Point2d outlineCrossing(const cv::Mat& mask, const cv::Point2d& start, const
     bool wasInside = false;
     const double maxSteps = 2.0 * (mask.cols + mask.rows);
     for (int i = 0; i < maxSteps; ++i, p += step) {
-        const int x = static_cast<int>(std::lround(p.x)), y = static_cast<int>(std::lround(p.y));
-        const bool inside = x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<unsigned char>(y, x) != 0;
-        if (inside) {
+        if (inMask(mask, p)) {
             lastInside = p;
             wasInside = true;
         } else if (wasInside) {
@@ -173,9 +177,7 @@ std::vector<std::uint32_t> faceProfileVertices(const BaseHead& base) {
         const glm::dvec2 n = projectToView(normals[v], View::Side);
         if (glm::length(n) < 0.5) continue;
         const glm::dvec2 out2 = projectToView(p, View::Side) + 1.5 * glm::normalize(n);
-        const cv::Point2d q = px(glm::dvec3(0.0, out2.y, out2.x));
-        const int x = static_cast<int>(std::lround(q.x)), y = static_cast<int>(std::lround(q.y));
-        if (x < 0 || y < 0 || x >= mask.cols || y >= mask.rows || mask.at<unsigned char>(y, x) == 0) out.push_back(v);
+        if (!inMask(mask, px(glm::dvec3(0.0, out2.y, out2.x)))) out.push_back(v);
     }
     std::sort(out.begin(), out.end(), [&](std::uint32_t a, std::uint32_t b) { return m.positions[a].y > m.positions[b].y; });
     return out;
@@ -184,16 +186,12 @@ std::vector<std::uint32_t> faceProfileVertices(const BaseHead& base) {
 // Where the outline of `mask` crosses the segment through `at` along `dir` (pixels, unit length) within `reach`
 // pixels either way: the crossing from inside to outside (going along dir) nearest `at`.
 std::optional<cv::Point2d> outlineAlongNormal(const cv::Mat& mask, const cv::Point2d& at, const cv::Point2d& dir, double reach) {
-    const auto inside = [&](const cv::Point2d& p) {
-        const int x = static_cast<int>(std::lround(p.x)), y = static_cast<int>(std::lround(p.y));
-        return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<unsigned char>(y, x) != 0;
-    };
     std::optional<cv::Point2d> best;
     double bestDistance = 1e300;
-    bool wasInside = inside(at - dir * reach);
+    bool wasInside = inMask(mask, at - dir * reach);
     for (double t = -reach + 0.5; t <= reach; t += 0.5) {
         const cv::Point2d p = at + dir * t;
-        const bool in = inside(p);
+        const bool in = inMask(mask, p);
         if (wasInside && !in && std::abs(t) < bestDistance) {
             bestDistance = std::abs(t);
             best = at + dir * (t - 0.25);
