@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -53,7 +54,6 @@ TEST(ModifierFit, RecoversKnownWeightsScaleAndShift) {
     const glm::dvec3 scale(1.1, 0.95, 1.05), centre(0.0, 2.0, -3.0), shift(4.0, -2.5, 1.5);
     ModifierFitOptions o;
     o.regularisation = 1e-9;
-    o.sweeps = 5000;
     const ModifierFit f = fitModifiers(p.basis, p.base, scale, centre, targetsFor(p, truth, scale, centre, shift), o);
     ASSERT_EQ(f.weights.size(), truth.size());
     for (std::size_t k = 0; k < truth.size(); ++k) EXPECT_NEAR(f.weights[k], truth[k], 1e-5) << k;
@@ -74,7 +74,6 @@ TEST(ModifierFit, WeightsStayWithinTheirRange) {
         targets[i].target -= projectToView(moved[targets[i].vertex] - p.base[targets[i].vertex], targets[i].view);
     ModifierFitOptions o;
     o.regularisation = 1e-9;
-    o.sweeps = 5000;
     const ModifierFit f = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
     EXPECT_DOUBLE_EQ(f.weights[0], 1.0);
     EXPECT_DOUBLE_EQ(f.weights[1], 0.0);
@@ -92,7 +91,6 @@ TEST(ModifierFit, RegularisationPullsTowardsTheAverage) {
     for (const double lambda : {1e-6, 100.0, 10000.0, 1e7}) {
         ModifierFitOptions o;
         o.regularisation = lambda;
-        o.sweeps = 5000;
         const ModifierFit f = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
         double sum = 0.0;
         for (const double w : f.weights) sum += w;
@@ -117,7 +115,6 @@ TEST(ModifierFit, OutlineTargetsCountAlongTheirNormalOnly) {
     ModifierFitOptions o;
     o.regularisation = 1e-9;
     o.robustMm = 0.0;
-    o.sweeps = 5000;
     const ModifierFit f = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
     for (std::size_t k = 0; k < truth.size(); ++k) EXPECT_NEAR(f.weights[k], truth[k], 1e-5) << k;
     // The same targets as points pull the front y by 9 mm: the weights go wrong.
@@ -141,7 +138,6 @@ TEST(ModifierFit, RobustWeightsKeepAMisplacedPointFromBendingTheHead) {
         o.regularisation = 1e-9;
         o.robustMm = robustMm;
         o.robustIterations = 10;
-        o.sweeps = 5000;
         const ModifierFit f = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
         double sum = 0.0;
         for (std::size_t k = 0; k < truth.size(); ++k) sum += std::abs(f.weights[k] - truth[k]);
@@ -150,6 +146,63 @@ TEST(ModifierFit, RobustWeightsKeepAMisplacedPointFromBendingTheHead) {
     const double plain = error(0.0), robust = error(1.0);
     EXPECT_GT(plain, 0.05);
     EXPECT_LT(robust, 0.25 * plain);
+}
+
+// Many overlapping modifiers (correlated, as MakeHuman's are) asked for weights partly beyond their range, with noise:
+// the result is the exact optimum of the bounded problem. No single weight can be moved within its range, nor the
+// translation, to lower the objective (the sum of squared target errors plus lambda times the squared weights).
+TEST(ModifierFit, ReachesTheBoundedOptimum) {
+    Problem p = makeProblem();
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-4.0f, 4.0f);
+    for (int k = 4; k < 30; ++k) {
+        Modifier m;
+        m.name = "extra" + std::to_string(k);
+        for (std::uint32_t v = 0; v < p.base.size(); ++v)
+            if ((v + static_cast<std::uint32_t>(k)) % 3 != 0) {
+                m.vertices.push_back(v);
+                m.offsets.emplace_back(u(rng), u(rng), u(rng));
+            }
+        p.basis.modifiers.push_back(m);
+    }
+    std::vector<double> asked(p.basis.modifiers.size());
+    std::uniform_real_distribution<double> w(-0.6, 1.6);
+    for (double& a : asked) a = w(rng);
+    auto targets = targetsFor(p, asked, glm::dvec3(1.0), glm::dvec3(0.0), glm::dvec3(2.0, -1.0, 3.0));
+    std::normal_distribution<double> noise(0.0, 0.5);
+    for (auto& t : targets) t.target += glm::dvec2(noise(rng), noise(rng));
+    ModifierFitOptions o;
+    o.regularisation = 2.0;
+    o.robustMm = 0.0;
+    o.fixedGroups.clear();
+    const ModifierFit f = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
+    const auto objective = [&](const std::vector<double>& weights, const glm::dvec3& shift) {
+        const auto shaped = p.basis.apply(p.base, weights);
+        double e = 0.0;
+        for (const auto& t : targets) {
+            const glm::dvec2 d = projectToView(shaped[t.vertex] + shift, t.view) - t.target;
+            e += glm::dot(d, d);
+        }
+        for (const double x : weights) e += o.regularisation * x * x;
+        return e;
+    };
+    const double best = objective(f.weights, f.translation);
+    int atBound = 0;
+    for (std::size_t k = 0; k < f.weights.size(); ++k) {
+        atBound += f.weights[k] == 0.0 || f.weights[k] == 1.0;
+        for (const double step : {-1e-4, 1e-4}) {
+            std::vector<double> moved = f.weights;
+            moved[k] = std::clamp(moved[k] + step, 0.0, 1.0);
+            EXPECT_GE(objective(moved, f.translation), best - 1e-9) << k << " " << step;
+        }
+    }
+    EXPECT_GT(atBound, 3);  // the bounds matter in this problem
+    for (int axis = 0; axis < 3; ++axis)
+        for (const double step : {-1e-4, 1e-4}) {
+            glm::dvec3 shift = f.translation;
+            shift[axis] += step;
+            EXPECT_GE(objective(f.weights, shift), best - 1e-9) << axis;
+        }
 }
 
 }  // namespace

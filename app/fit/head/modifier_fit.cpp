@@ -1,7 +1,12 @@
 // Bounded ridge least squares for the modifier weights (modifier_fit.h), solved on the normal equations by
-// projected Gauss-Seidel: a few hundred unknowns and rows, so the dense system is small and each sweep is exact
-// coordinate descent of a convex problem with box bounds.
+// projected Newton steps (Bertsekas, "Projected Newton methods for optimization problems with simple constraints",
+// SIAM J. Control Optim. 20(2), 1982): a few hundred unknowns, so the dense system is small; each step solves the
+// free variables' system exactly (dlib's Cholesky) and projects onto the box, so the set of weights held at 0 or 1
+// changes by many at once and the exact optimum is reached in a handful of steps, where coordinate descent needed
+// hundreds of sweeps and stopped short of it.
 #include "fit/head/modifier_fit.h"
+
+#include <dlib/matrix.h>
 
 #include <algorithm>
 #include <cmath>
@@ -19,6 +24,65 @@ std::pair<glm::dvec2, glm::dvec2> rowDirections(const ModifierTarget& t) {
         return {std::sqrt(t.weight.x) * n, std::sqrt(t.weight.y) * glm::dvec2(-n.y, n.x)};
     }
     return {glm::dvec2(std::sqrt(t.weight.x), 0.0), glm::dvec2(0.0, std::sqrt(t.weight.y))};
+}
+
+// 1/2 x^T N x - g^T x, N dense n x n row-major.
+double objective(const std::vector<double>& N, const std::vector<double>& g, const std::vector<double>& x) {
+    const std::size_t n = x.size();
+    double f = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        double s = 0.0;
+        for (std::size_t j = 0; j < n; ++j) s += N[i * n + j] * x[j];
+        f += x[i] * (0.5 * s - g[i]);
+    }
+    return f;
+}
+
+// Minimises objective(N, g, x) over lo <= x <= hi from a feasible x (N symmetric positive definite). A variable at a
+// bound whose gradient pushes it outwards is held there; Newton's step for the others is projected onto the box and
+// halved until it decreases the objective enough (Armijo along the projection arc).
+void minimiseInBox(const std::vector<double>& N, const std::vector<double>& g, const std::vector<double>& lo,
+                   const std::vector<double>& hi, std::vector<double>& x, int maxSteps) {
+    const std::size_t n = x.size();
+    double f = objective(N, g, x);
+    std::vector<double> gradient(n), next(n);
+    std::vector<std::size_t> free;
+    for (int step = 0; step < maxSteps; ++step) {
+        free.clear();
+        double largest = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            double s = -g[i];
+            for (std::size_t j = 0; j < n; ++j) s += N[i * n + j] * x[j];
+            gradient[i] = s;
+            if ((x[i] <= lo[i] && s >= 0.0) || (x[i] >= hi[i] && s <= 0.0)) continue;
+            free.push_back(i);
+            largest = std::max(largest, std::abs(s));
+        }
+        if (largest < 1e-9) return;  // the projected gradient vanishes: optimal
+        const long m = static_cast<long>(free.size());
+        dlib::matrix<double> Nf(m, m);
+        dlib::matrix<double, 0, 1> minusGradient(m);
+        for (long a = 0; a < m; ++a) {
+            for (long b = 0; b < m; ++b) Nf(a, b) = N[free[a] * n + free[b]];
+            minusGradient(a) = -gradient[free[a]];
+        }
+        const dlib::matrix<double, 0, 1> d = dlib::cholesky_decomposition<dlib::matrix<double>>(Nf).solve(minusGradient);
+        double alpha = 1.0, fNext = f;
+        for (int halving = 0; halving < 40; ++halving, alpha *= 0.5) {
+            next = x;
+            double decrease = 0.0;
+            for (long a = 0; a < m; ++a) {
+                const std::size_t i = free[a];
+                next[i] = std::clamp(x[i] + alpha * d(a), lo[i], hi[i]);
+                decrease += gradient[i] * (next[i] - x[i]);
+            }
+            fNext = objective(N, g, next);
+            if (fNext <= f + 1e-4 * decrease) break;
+        }
+        if (!(fNext < f)) return;  // no step decreases it any more (rounding)
+        x.swap(next);
+        f = fNext;
+    }
 }
 
 }  // namespace
@@ -66,6 +130,12 @@ ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec
                    options.fixedGroups.end();
     // Iteratively reweighted least squares (Huber): after each solve a target whose error exceeds robustMm counts
     // with weight robustMm / error, so that one misplaced point (a chin found on the lip) cannot bend the head.
+    // The box: modifiers within their slider range (held ones at 0), the translation free.
+    std::vector<double> lower(n, -std::numeric_limits<double>::infinity()), upper(n, std::numeric_limits<double>::infinity());
+    for (std::size_t k = 0; k < K; ++k) {
+        lower[k] = 0.0;
+        upper[k] = fixed[k] ? 0.0 : 1.0;
+    }
     std::vector<double> w(n, 0.0), rowWeight(rows, 1.0);
     const int solves = options.robustMm > 0.0 ? 1 + options.robustIterations : 1;
     for (int solve = 0; solve < solves; ++solve) {
@@ -98,20 +168,7 @@ ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec
             N[k * n + k] += group != options.groupRegularisation.end() ? group->second : options.regularisation;
         }
         for (std::size_t i = K; i < n; ++i) N[i * n + i] += 1e-9;
-        for (int sweep = 0; sweep < options.sweeps; ++sweep) {
-            double change = 0.0;
-            for (std::size_t i = 0; i < n; ++i) {
-                if (fixed[i] || N[i * n + i] <= 0.0) continue;
-                double s = g[i];
-                const double* row = &N[i * n];
-                for (std::size_t j = 0; j < n; ++j) s -= row[j] * w[j];
-                double next = w[i] + s / row[i];
-                if (i < K) next = std::clamp(next, 0.0, 1.0);
-                change = std::max(change, std::abs(next - w[i]));
-                w[i] = next;
-            }
-            if (change < 1e-7) break;
-        }
+        minimiseInBox(N, g, lower, upper, w, options.maxNewtonSteps);
     }
     ModifierFit fit;
     fit.weights.assign(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(K));

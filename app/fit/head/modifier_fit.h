@@ -39,7 +39,7 @@ struct ModifierFitOptions {
     // Groups held more firmly: the head's and the neck's shape move the whole skull, which only the outline rays see
     // (through hair); the face's landmarks alone would bend it.
     std::map<std::string, double> groupRegularisation = {{"head", 300.0}, {"neck", 300.0}};
-    int sweeps = 400;  // projected Gauss-Seidel sweeps over the normal equations
+    int maxNewtonSteps = 100;  // of the bounded solve (it ends at the optimum, after 3-12 steps on the booth's fits)
     // Huber's threshold in millimetres (0: plain least squares) and how many times the weights are made again. A
     // detected landmark is often a millimetre off, and now and then a profile point lands on the wrong bump.
     double robustMm = 1.0;
