@@ -12,8 +12,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <set>
 #include <tuple>
 
@@ -84,6 +86,32 @@ TEST(MakeHumanHead, IsClosedAndCarriesItsModifiersAndSkin) {
     EXPECT_FALSE(head.skin.empty());
     EXPECT_EQ(head.rigidParts.size(), 2u);  // the eyeballs
     EXPECT_EQ(head.frontFeatures.size(), 68u);
+}
+
+// The neck's cut edge is smooth, not a saw of whole quads: its vertices lie on the cut surface, level within 5 cm of
+// the midline and rising 1.5 mm per mm beyond (MakeHumanImportOptions::neckCutDm), to the hundredth of a millimetre.
+TEST(MakeHumanHead, NeckEdgeLiesOnTheCutSurface) {
+    REQUIRE_MAKEHUMAN_HEAD();
+    const Mesh& m = productBaseHead()->mesh;
+    // The caps are fans: their centres have far more neighbours than any vertex of the surface; the neck's is lowest.
+    std::map<std::uint32_t, std::set<std::uint32_t>> neighbours;
+    for (const auto& t : m.triangles)
+        for (int k = 0; k < 3; ++k) neighbours[t[k]].insert(t[(k + 1) % 3]);
+    std::optional<std::uint32_t> neck;
+    for (const auto& [v, n] : neighbours)
+        if (n.size() > 20 && (!neck || m.positions[v].y < m.positions[*neck].y)) neck = v;
+    ASSERT_TRUE(neck);
+    const std::set<std::uint32_t>& edge = neighbours[*neck];
+    ASSERT_GT(edge.size(), 30u);
+    double level = 1e9;
+    for (const auto v : edge) level = std::min(level, m.positions[v].y);
+    int flat = 0;
+    for (const auto v : edge) {
+        const glm::dvec3& p = m.positions[v];
+        EXPECT_NEAR(p.y - level, 1.5 * std::max(0.0, std::abs(p.x) - 50.0), 0.01) << "x " << p.x << " z " << p.z;
+        flat += std::abs(p.x) < 50.0;
+    }
+    EXPECT_GT(flat, 10);  // front and back of the neck
 }
 
 TEST(MakeHumanHead, FeatureVerticesAreOnTheFaceWhereTheFrontViewSeesThem) {

@@ -329,15 +329,14 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
     for (std::size_t i = 0; i < human.size(); ++i) human[i] += defaults[i];
 
     // --- The head's quads: the body above the neck cut, and the eyeballs.
+    // The cut surface's height at a point: it rises to the sides, where the neck widens into the shoulders, so that
+    // it leaves a round neck and no tongues of trapezius.
+    const auto neckCut = [&](const glm::dvec3& p) { return options.neckCutDm + 1.5 * std::max(0.0, std::abs(p.x) - 0.5); };
     std::vector<const Quad*> kept;
     for (const Quad& q : body.quads) {
         if (q.material == kRightEyeMaterial || q.material == kLeftEyeMaterial) kept.push_back(&q);
         else if (q.material == kBodyMaterial &&
-                 std::all_of(q.v.begin(), q.v.end(), [&](std::uint32_t v) {
-                     // The cut rises to the sides, where the neck widens into the shoulders, so that it leaves a
-                     // round neck and no tongues of trapezius.
-                     return human[v].y > options.neckCutDm + 1.5 * std::max(0.0, std::abs(human[v].x) - 0.5);
-                 }))
+                 std::all_of(q.v.begin(), q.v.end(), [&](std::uint32_t v) { return human[v].y > neckCut(human[v]); }))
             kept.push_back(&q);
     }
 
@@ -453,6 +452,21 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
         caps.push_back(std::move(cap));
     }
     if (caps.empty()) throw BoothError(ErrorKind::BadConfig, packageDir.string(), "the cut head has no opening at the neck");
+    // The neck's opening runs along whole quads, up and down by a row where the cut surface crosses them: a saw edge
+    // in every view of the avatar. Its vertices are moved down onto the cut surface (the neck's lowest loop), so the
+    // edge is as smooth as the surface, and the quads of the last row stretch a little.
+    {
+        const auto meanY = [&](const Cap& c) {
+            double sum = 0.0;
+            for (const auto v : c.loop) sum += human[v].y;
+            return sum / static_cast<double>(c.loop.size());
+        };
+        const Cap& neck = *std::min_element(caps.begin(), caps.end(), [&](const Cap& a, const Cap& b) { return meanY(a) < meanY(b); });
+        const std::set<std::uint32_t> onNeckEdge(neck.loop.begin(), neck.loop.end());
+        for (const auto v : neck.loop) human[v].y = neckCut(human[v]);
+        for (const auto& [key, headVertex] : vertexOf)
+            if (onNeckEdge.count(key.first)) mesh.positions[headVertex] = human[key.first] * kMmPerDm;
+    }
     const Island& capSquare = islands.back();
     for (Cap& cap : caps) {
         glm::dvec3 centre(0.0), loopLo(1e9), loopHi(-1e9);
