@@ -111,7 +111,7 @@ TEST(QuantizedShapePredictor, LandmarksMatchDlibsOwnPredictorOnRealFaces) {
 
     const LandmarkDetector faces(modelFile);
     int photos = 0, points = 0, identical = 0, annotated = 0;
-    double worst = 0.0, sum = 0.0, dlibError = 0.0, quantizedError = 0.0;
+    double worst = 0.0, sum = 0.0, dlibError = 0.0, quantizedError = 0.0, subpixelError = 0.0;
     for (const fs::path& file : frontalPhotos()) {
         const cv::Mat photo = readPhoto(file);
         cv::Mat grey;
@@ -124,6 +124,13 @@ TEST(QuantizedShapePredictor, LandmarksMatchDlibsOwnPredictorOnRealFaces) {
             dlib::cv_image<unsigned char>(grey), dlib::rectangle(box.x, box.y, box.x + box.width - 1, box.y + box.height - 1));
         const std::vector<cv::Point> got = quantized.predict(grey, box);
         ASSERT_EQ(got.size(), want.num_parts());
+        // The unrounded points are what predict() rounds: each within half a pixel of its whole-pixel point.
+        const std::vector<cv::Point2d> exact = quantized.predictSubpixel(grey, box);
+        ASSERT_EQ(exact.size(), got.size());
+        for (std::size_t k = 0; k < got.size(); ++k) {
+            EXPECT_LE(std::abs(exact[k].x - got[k].x), 0.5 + 1e-9) << file << " " << k;
+            EXPECT_LE(std::abs(exact[k].y - got[k].y), 0.5 + 1e-9) << file << " " << k;
+        }
         double photoWorst = 0.0;
         for (unsigned long k = 0; k < want.num_parts(); ++k) {
             const double d = std::hypot(got[k].x - static_cast<double>(want.part(k).x()),
@@ -145,13 +152,15 @@ TEST(QuantizedShapePredictor, LandmarksMatchDlibsOwnPredictorOnRealFaces) {
                 const cv::Point2d dlibPoint(static_cast<double>(want.part(k).x()), static_cast<double>(want.part(k).y()));
                 dlibError += cv::norm(dlibPoint - (*truth)[k]) / (68.0 * box.width);
                 quantizedError += cv::norm(cv::Point2d(got[k]) - (*truth)[k]) / (68.0 * box.width);
+                subpixelError += cv::norm(exact[k] - (*truth)[k]) / (68.0 * box.width);
             }
         }
     }
     std::printf("quantized shape predictor: %d faces, %d points, %d identical to dlib's, mean %.3f px, worst %.2f px\n",
                 photos, points, identical, sum / points, worst);
     std::printf("quantized shape predictor: error against the hand-placed points of %d faces, of the face box's width: "
-                "dlib %.4f, 16-bit %.4f\n", annotated, dlibError / annotated, quantizedError / annotated);
+                "dlib %.4f, 16-bit %.4f, 16-bit unrounded %.4f\n", annotated, dlibError / annotated, quantizedError / annotated,
+                subpixelError / annotated);
     EXPECT_GE(photos, 15);
     // dlib's own output is rounded to whole pixels (up to 0.7 px off): the 16-bit leaves add far less than that.
     EXPECT_GE(identical, points * 85 / 100);
@@ -159,6 +168,8 @@ TEST(QuantizedShapePredictor, LandmarksMatchDlibsOwnPredictorOnRealFaces) {
     // And the landmarks are as close to the truth as dlib's (within 0.1% of the face box).
     ASSERT_GE(annotated, 3);
     EXPECT_NEAR(quantizedError / annotated, dlibError / annotated, 0.001);
+    // Unrounded (what the booth uses), no further from them.
+    EXPECT_LE(subpixelError, quantizedError + 1e-4 * annotated);
 }
 
 TEST(QuantizedShapePredictor, DamagedModelFilesAreRefusedWithTheirName) {

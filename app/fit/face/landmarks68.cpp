@@ -28,9 +28,10 @@ struct LandmarkDetector::Impl {
     std::vector<cv::Rect> faces(const cv::Mat& fullGrey);
     // The 68 points inside a face box.
     std::array<cv::Point2d, 68> landmarks(const cv::Mat& grey, const cv::Rect& face) {
-        const std::vector<cv::Point> shape = predictor->predict(grey, face);
+        // Unrounded: dlib rounds its points to whole pixels, half a pixel of noise the fit need not have.
+        const std::vector<cv::Point2d> shape = predictor->predictSubpixel(grey, face);
         std::array<cv::Point2d, 68> points{};
-        for (unsigned k = 0; k < 68; ++k) points[k] = cv::Point2d(shape[k]);
+        for (unsigned k = 0; k < 68; ++k) points[k] = shape[k];
         return points;
     }
 };

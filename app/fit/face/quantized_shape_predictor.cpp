@@ -358,7 +358,7 @@ std::size_t QuantizedShapePredictor::modelBytes() const {
            model_->scales.size() * sizeof(float) + model_->leaves.size() * sizeof(std::int16_t);
 }
 
-std::vector<cv::Point> QuantizedShapePredictor::predict(const cv::Mat& grey, const cv::Rect& face) const {
+std::vector<cv::Point2d> QuantizedShapePredictor::predictSubpixel(const cv::Mat& grey, const cv::Rect& face) const {
     if (grey.type() != CV_8UC1) throw BoothError(ErrorKind::Internal, "", "shape predictor: an 8-bit grey image is expected");
     const Model& m = *model_;
     const dlib::cv_image<unsigned char> image(grey);
@@ -384,9 +384,19 @@ std::vector<cv::Point> QuantizedShapePredictor::predict(const cv::Mat& grey, con
         }
     }
     const dlib::point_transform_affine toImage = dlib::impl::unnormalizing_tform(box);
-    std::vector<cv::Point> points(m.dims / 2);
+    std::vector<cv::Point2d> points(m.dims / 2);
     for (std::size_t p = 0; p < points.size(); ++p) {
-        const dlib::point rounded = toImage(dlib::impl::location(shape, p));  // dlib's rounding to whole pixels
+        const dlib::dpoint at = toImage(dlib::dpoint(dlib::impl::location(shape, p)));
+        points[p] = cv::Point2d(at.x(), at.y());
+    }
+    return points;
+}
+
+std::vector<cv::Point> QuantizedShapePredictor::predict(const cv::Mat& grey, const cv::Rect& face) const {
+    const std::vector<cv::Point2d> exact = predictSubpixel(grey, face);
+    std::vector<cv::Point> points(exact.size());
+    for (std::size_t p = 0; p < points.size(); ++p) {
+        const dlib::point rounded(dlib::dpoint(exact[p].x, exact[p].y));  // dlib's rounding to whole pixels
         points[p] = cv::Point(static_cast<int>(rounded.x()), static_cast<int>(rounded.y()));
     }
     return points;

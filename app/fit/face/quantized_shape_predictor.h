@@ -39,6 +39,8 @@ public:
     // The landmarks inside `face` (image pixels) of an 8-bit grey image, rounded to whole pixels as dlib rounds
     // them. Thread-safe: the model is only read.
     std::vector<cv::Point> predict(const cv::Mat& grey, const cv::Rect& face) const;
+    // The same before the rounding (dlib's regression gives a fraction of a pixel, which it throws away).
+    std::vector<cv::Point2d> predictSubpixel(const cv::Mat& grey, const cv::Rect& face) const;
     // Bytes held by the trees (splits, leaves and their scales).
     std::size_t modelBytes() const;
     // The cache file load() read the trees from (else empty: they were converted from the model file).
