@@ -394,6 +394,7 @@ MakeHumanVisitor makeMakeHumanVisitor(const BaseHead& mh, MeshRenderer& renderer
     setup.mmPerPixel = options.mmPerPixel;
     setup.imageSize = options.imageSize;
     setup.sideNoseImageRight = options.sideNoseImageRight;
+    setup.sideYawDeg = options.sideYawDeg;
     setup.lit = options.lit;
     setup.backdropSeed = options.seed;
     setup.target = {0.0, -35.0, 0.0};  // MakeHuman's head is a little taller above the ear hole than the test head

@@ -28,6 +28,7 @@ struct MakeHumanVisitorOptions {
     double mmPerPixel = 0.6;
     cv::Size imageSize{972, 720};
     bool sideNoseImageRight = true;
+    double sideYawDeg = 90.0;  // the side photo's angle from the front (SyntheticPhotoSetup::sideYawDeg)
     bool lit = true;
     // Where the skins are (NAME.jpg on the base head's UVs, as make-base-head writes them); empty: the skins/ folder
     // beside the product's base head (findMakeHumanBaseHead()).

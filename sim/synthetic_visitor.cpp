@@ -184,12 +184,26 @@ void drawShoulders(cv::Mat& image, const RenderCamera& camera, bool side, const 
                    {0, -900, neck.frontZ + 80}, {0, -900, neck.backZ - 70},   {0, y - 100, neck.backZ - 65},
                    {0, y - 40, neck.backZ - 20}, {0, y, neck.backZ}};
     }
-    std::vector<cv::Point> poly;
-    for (const auto& p : outline) {
-        const glm::dvec2 px = camera.project(p);
-        poly.emplace_back(static_cast<int>(std::lround(px.x - 0.5)), static_cast<int>(std::lround(px.y - 0.5)));
+    std::vector<std::vector<glm::dvec3>> outlines{outline};
+    if (side && setup.sideYawDeg != 90.0) {
+        // Turned off the profile, the shoulders' breadth shows too: the front's outline, in the plane half-way
+        // between the neck's front and back, drawn as well.
+        const double zMid = 0.5 * (neck.frontZ + neck.backZ);
+        outlines.push_back({{-x, y, zMid}, {-x - 22, y - 40, zMid}, {-185, y - 65, zMid}, {-215, y - 150, zMid},
+                            {-230, -900, zMid}, {230, -900, zMid}, {215, y - 150, zMid}, {185, y - 65, zMid},
+                            {x + 22, y - 40, zMid}, {x, y, zMid}});
     }
-    cv::fillPoly(image, std::vector<std::vector<cv::Point>>{poly}, setup.shirt, cv::LINE_AA);
+    std::vector<std::vector<cv::Point>> polys;
+    for (const auto& o : outlines) {
+        std::vector<cv::Point> poly;
+        for (const auto& p : o) {
+            const glm::dvec2 px = camera.project(p);
+            poly.emplace_back(static_cast<int>(std::lround(px.x - 0.5)), static_cast<int>(std::lround(px.y - 0.5)));
+        }
+        polys.push_back(std::move(poly));
+    }
+    for (const auto& poly : polys)
+        cv::fillPoly(image, std::vector<std::vector<cv::Point>>{poly}, setup.shirt, cv::LINE_AA);
 }
 
 cv::Mat composite(const cv::Mat& backdrop, const RenderResult& head, const RenderCamera& camera, bool side,
@@ -216,7 +230,11 @@ void photographSyntheticHead(SyntheticVisitor& v, const BaseHead& base, const gl
     v.frontCamera = RenderCamera::orthographic(setup.target + glm::dvec3(0, 0, 800), setup.target, {0, 1, 0},
                                                setup.mmPerPixel, w, h);
     const double sideSign = setup.sideNoseImageRight ? -1.0 : 1.0;  // camera on the subject's right: nose right
-    v.sideCamera = RenderCamera::orthographic(setup.target + glm::dvec3(sideSign * 800, 0, 0), setup.target, {0, 1, 0},
+    // At yaw 90 exactly (x on the axis): the same camera as before the yaw was an option, to the last bit.
+    const double yaw = setup.sideYawDeg * kPi / 180.0;
+    const glm::dvec3 sideDir = setup.sideYawDeg == 90.0 ? glm::dvec3(sideSign, 0, 0)
+                                                         : glm::dvec3(sideSign * std::sin(yaw), 0, std::cos(yaw));
+    v.sideCamera = RenderCamera::orthographic(setup.target + 800.0 * sideDir, setup.target, {0, 1, 0},
                                               setup.mmPerPixel, w, h);
     v.frontCamera.background = v.sideCamera.background = cv::Scalar(0, 0, 0);
     v.frontCamera.lit = v.sideCamera.lit = setup.lit;

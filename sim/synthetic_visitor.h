@@ -56,6 +56,10 @@ struct SyntheticPhotoSetup {
     double mmPerPixel = 0.6;
     cv::Size imageSize{972, 720};
     bool sideNoseImageRight = true;
+    // The side camera's angle from the front, degrees: 90 a true profile, less a visitor who has not turned far
+    // enough (60: both eyes show), more one turned past the profile (the back of the head shows more). The
+    // visitor turns whole, shoulders with the head.
+    double sideYawDeg = 90.0;
     bool lit = true;
     unsigned backdropSeed = 1;           // the backdrop's folds
     glm::dvec3 target{0.0, -45.0, 0.0};  // at the image centre: the head in the upper middle, shoulders below

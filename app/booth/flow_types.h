@@ -37,7 +37,8 @@ enum class Hint {
     MoveToCentre,  // front: the face is off the oval's centre
     LookAtCamera,  // front: the face is turned or tilted
     TurnRight,     // side: a frontal face (or nobody) is seen
-    TurnMore,      // side: turned, but no profile yet
+    TurnMore,      // side: turned, but not far enough for a profile
+    TurnBack,      // side: turned past the profile (the back of the head shows more than the face)
     HoldStill,     // ready (front or side)
 };
 
@@ -45,6 +46,7 @@ enum class Hint {
 enum class FitFailure {
     NoFace,       // no face found in the photo
     NotProfile,   // the side photo is not a profile (a front view)
+    TurnMore,     // the side photo is turned, but not far enough for a profile
     Mismatch,     // the two photos do not belong together
     Other,        // anything else (internal error, disk full, ...)
 };

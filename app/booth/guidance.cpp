@@ -30,12 +30,10 @@ Hint frontHint(const FrontObservation& obs, const GuidanceSettings& s) {
         return Hint::MoveToCentre;
     if (obs.landmarks) {
         const auto& p = *obs.landmarks;
-        const cv::Point2d eyeL = p[36], eyeR = p[45], nose = p[30];
+        const cv::Point2d eyeL = p[36], eyeR = p[45];
         const double eyes = cv::norm(eyeR - eyeL);
         if (eyes > 0.0) {
-            // Yaw: the nose tip's offset from the eyes' midpoint, along the eye line, in eye widths.
-            const cv::Point2d axis = (eyeR - eyeL) / eyes;
-            const double yaw = (nose - 0.5 * (eyeL + eyeR)).dot(axis) / eyes;
+            const double yaw = noseOffsetYaw(p);
             const double roll = std::atan2(eyeR.y - eyeL.y, eyeR.x - eyeL.x) * 180.0 / CV_PI;
             if (std::abs(yaw) > s.maxYaw || std::abs(roll) > s.maxRollDegrees) return Hint::LookAtCamera;
         }
@@ -44,8 +42,10 @@ Hint frontHint(const FrontObservation& obs, const GuidanceSettings& s) {
 }
 
 Hint sideHint(const SideObservation& obs) {
-    if (!obs.personSeen || obs.frontalFace) return Hint::TurnRight;
+    if (!obs.personSeen) return Hint::TurnRight;
+    if (obs.frontalFace) return std::abs(obs.frontalYaw) > kHalfTurnedYaw ? Hint::TurnMore : Hint::TurnRight;
     if (!obs.profileSeen) return Hint::TurnMore;
+    if (obs.turnDegrees >= kTurnBackDegrees) return Hint::TurnBack;
     return Hint::HoldStill;
 }
 
@@ -112,9 +112,13 @@ SideObservation PreviewAnalyser::observeSide(const cv::Mat& bgr, const cv::Mat& 
     cv::Mat grey;
     cv::cvtColor(small, grey, cv::COLOR_BGR2GRAY);
     cv::equalizeHist(grey, grey);
-    if (!frontalFaces(grey, std::max(24, grey.rows / 8), grey.rows).empty()) {
+    if (const auto faces = frontalFaces(grey, std::max(24, grey.rows / 8), grey.rows); !faces.empty()) {
         obs.personSeen = obs.frontalFace = true;
-        return obs;  // no need for the outline: the visitor has not turned yet
+        if (detector_) {
+            const cv::Rect& f = faces.front();
+            obs.frontalYaw = noseOffsetYaw(detector_->landmarksIn(small, f));
+        }
+        return obs;  // no need for the outline: the visitor has not turned far yet
     }
     cv::Mat mask;
     try {
@@ -129,8 +133,13 @@ SideObservation PreviewAnalyser::observeSide(const cv::Mat& bgr, const cv::Mat& 
     const ProfileFit right = fitProfile(outline, true), left = fitProfile(outline, false);
     if (right.ok || left.ok) {
         obs.noseImageRight = right.ok && (!left.ok || right.noseProminence >= left.noseProminence);
-        obs.noseProminence = (obs.noseImageRight ? right : left).noseProminence;
+        const ProfileFit& fit = obs.noseImageRight ? right : left;
+        obs.noseProminence = fit.noseProminence;
         obs.profileSeen = true;
+        if (fit.ok) {
+            const ProfileTurn turn = estimateProfileTurn(small, mask, fit.landmarks, obs.noseImageRight);
+            if (turn.known) obs.turnDegrees = turn.degrees;
+        }
     }
     return obs;
 }

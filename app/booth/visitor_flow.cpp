@@ -78,6 +78,7 @@ const char* toString(Hint hint) {
         case Hint::LookAtCamera: return "look_at_camera";
         case Hint::TurnRight: return "turn_right";
         case Hint::TurnMore: return "turn_more";
+        case Hint::TurnBack: return "turn_back";
         case Hint::HoldStill: return "hold_still";
     }
     return "?";

@@ -16,6 +16,7 @@ enum class FitPhoto { Front, Side, Both };
 enum class FitFault {
     NoFace,      // no face or head found where one was looked for
     NotProfile,  // the side photo shows a front view
+    TurnMore,    // the side photo is turned, but not far enough for a profile
     Mismatch,    // the two photos do not show the same head the same way
     Other,       // anything else (an unreadable file, an internal failure)
 };

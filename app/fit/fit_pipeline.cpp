@@ -163,6 +163,7 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         runStep(out, control, FitStep::SideProfile, names, [&] {
         SideOptions options;
         options.frontalCheck = frontalCheck_.get();
+        options.landmarkDetector = detector_.get();
         return analyseSidePhoto(side, background, options);
     });
     out.sideMask = sideAnalysis.mask;

@@ -131,3 +131,22 @@ TEST(Guidance, SideHintTable) {
         EXPECT_EQ(sideHint(o), r.hint) << "either facing direction";
     }
 }
+
+TEST(Guidance, SideHintSaysWhichWayToTurn) {
+    SideObservation o;
+    o.personSeen = o.frontalFace = true;
+    o.frontalYaw = 0.25;  // within kHalfTurnedYaw: looking at the camera
+    EXPECT_EQ(sideHint(o), Hint::TurnRight);
+    o.frontalYaw = -0.27;  // half-way round, either way
+    EXPECT_EQ(sideHint(o), Hint::TurnMore);
+    o.frontalYaw = 0.27;
+    EXPECT_EQ(sideHint(o), Hint::TurnMore);
+    o = {};
+    o.personSeen = o.profileSeen = true;
+    o.turnDegrees = 19.0;  // short of kTurnBackDegrees past the profile
+    EXPECT_EQ(sideHint(o), Hint::HoldStill);
+    o.turnDegrees = -40.0;  // short of the profile: the outline's own test says "turn more" when it fails
+    EXPECT_EQ(sideHint(o), Hint::HoldStill);
+    o.turnDegrees = 20.0;
+    EXPECT_EQ(sideHint(o), Hint::TurnBack);
+}

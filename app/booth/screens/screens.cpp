@@ -90,6 +90,7 @@ std::string bannerKey(const ScreenModel& m) {
             switch (m.fitFailure) {
                 case FitFailure::NoFace: return "error.fit.no_face";
                 case FitFailure::NotProfile: return "error.fit.not_profile";
+                case FitFailure::TurnMore: return "error.fit.turn_more";
                 case FitFailure::Mismatch: return "error.fit.mismatch";
                 case FitFailure::Other: return "error.fit.other";
             }

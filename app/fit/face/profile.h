@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/objdetect.hpp>
 
+#include <array>
 #include <filesystem>
 #include <mutex>
 #include <string>
@@ -11,6 +12,8 @@
 #include <vector>
 
 namespace avatarbooth {
+
+class LandmarkDetector;
 
 // A named 2-D point of a profile, in the frame of the outline it was found on.
 struct ProfilePoint {
@@ -57,12 +60,28 @@ std::vector<ProfilePoint> findProfileLandmarks(const std::vector<cv::Point2d>& o
 // The point called `name`; throws BoothError(Internal) when it is missing.
 cv::Point2d profilePoint(const std::vector<ProfilePoint>& points, std::string_view name);
 
+// How far a side photo is turned from a true profile, from what the photo shows inside the outline: the outline
+// alone cannot tell (orthographically, a symmetric head turned 20 degrees short of the profile and one turned 20
+// degrees past it have the same outline). See profile.cpp for the cue, its calibration and its limits.
+struct ProfileTurn {
+    bool known = false;
+    // Degrees off the profile: < 0 not turned far enough (more of the face shows), > 0 turned past it (more of
+    // the back of the head shows).
+    double degrees = 0.0;
+    double eyeBehind = 0.0;  // the visible eye's distance behind the face's outline, in V
+};
+
+// The turn of a side photo whose profile landmarks are known (facing as noseImageRight says).
+ProfileTurn estimateProfileTurn(const cv::Mat& bgr, const cv::Mat& mask, const std::vector<ProfilePoint>& landmarks,
+                                bool noseImageRight);
+
 struct SideAnalysis {
     cv::Mat mask;                        // CV_8U, 255 on the person (see segmentPerson)
     bool noseImageRight = true;          // the subject faces image-right
     std::vector<cv::Point2d> outline;    // the silhouette's outline, original image coordinates
     std::vector<ProfilePoint> landmarks; // kProfileLandmarkNames, original image coordinates
     std::vector<std::string> warnings;
+    ProfileTurn turn;
 };
 
 // OpenCV's frontal-face cascade, which refuses a side photo that shows a front view. LBP "improved" is preferred:
@@ -91,7 +110,21 @@ struct SideOptions {
     FrontalFaceCheck* frontalCheck = nullptr;
     // Run the frontal-face detector on the head and refuse a front view.
     bool rejectFrontViews = true;
+    // With it, a frontal face found on the head gets dlib's 68 points: turned more than kHalfTurnedYaw it is a
+    // visitor half-way round (told to turn more), else a front view. Null: every frontal face is a front view.
+    const LandmarkDetector* landmarkDetector = nullptr;
 };
+
+// A face's turn from the front by its 68 points: the nose tip's offset from the middle of the eyes' outer corners,
+// along the eye line, in eye widths (positive: the nose towards image-right). The front guide's measure.
+double noseOffsetYaw(const std::array<cv::Point2d, 68>& points);
+// Beyond this |noseOffsetYaw| a face is half-turned (the front guide's maxYaw: frmdb's fronts -0.23 to 0.15, its
+// 45-degree views 0.28-0.38 where the frontal cascade still finds them).
+inline constexpr double kHalfTurnedYaw = 0.26;
+// The side guide says "turn a little back" when ProfileTurn puts the visitor this far past the profile: the eye
+// within 0.034 V of the outline. Measured maxima: +19 on MakeHuman visitors turned 110 and 120 degrees (the cue
+// saturates there), +16 on frmdb's profiles; so it fires only on a head turned further than those.
+inline constexpr double kTurnBackDegrees = 20.0;
 
 // Analyses a side photo: silhouette (with the empty-booth plate when not empty), facing direction (either way
 // works: the outline is fitted both ways, a nose pointing left is fitted mirrored and the points mapped back),
