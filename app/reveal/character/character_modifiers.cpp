@@ -16,10 +16,10 @@ namespace {
 // each eye's sideways move. Eye size, ear position and size, brow, nose and mouth height: the part's own size or
 // vertical move. Eye tilt: the outer eye corner up or down (MakeHuman's eye-corner1); brow tilt: the brows' angle.
 const std::vector<CharacterControl> kControls = {
-    {{"head/head-scale-vert-less"}, "r0"},
-    {{"head/head-scale-vert-more"}, "r0"},
-    {{"head/head-scale-horiz-less"}, "r0"},
-    {{"head/head-scale-horiz-more"}, "r0"},
+    {{"head/head-scale-vert-less"}, "r0", 100.0},
+    {{"head/head-scale-vert-more"}, "r0", 100.0},
+    {{"head/head-scale-horiz-less"}, "r0", 100.0},
+    {{"head/head-scale-horiz-more"}, "r0", 100.0},
     {{"chin/chin-height-min"}, "r0"},
     {{"chin/chin-height-max"}, "r0"},
     {{"eyes/r-eye-move-in"}, "r1, eye_spacing"},
@@ -136,6 +136,7 @@ CharacterModel characterModelOf(const BaseHead& base, double pxPerMm, double pro
             ks.push_back(k);
         }
         model.controlModifiers.push_back(std::move(ks));
+        model.firmness.push_back(control.firmness);
     }
     // The ear hole moves as the ears do: the mean displacement of every vertex an ear modifier moves.
     const std::set<std::uint32_t> ears = earVertices(basis);
@@ -174,7 +175,8 @@ std::vector<double> solveCharacterStep(const CharacterModel& model, const std::v
             for (std::size_t b = 0; b < n; ++b) N[a * n + b] += ja * model.jacobian[b][i] * scale;
         }
     }
-    for (std::size_t a = 0; a < n; ++a) N[a * n + a] += regularisation;
+    for (std::size_t a = 0; a < n; ++a)
+        N[a * n + a] += regularisation * (a < model.firmness.size() ? model.firmness[a] : 1.0);
     // Projected Gauss-Seidel within [0, 1]: a few dozen unknowns, the dense system is small. A slider's two ends
     // (controls 2k and 2k + 1) are never both on, as on MakeHuman's own slider: where the solution has both, the
     // weaker end is held at 0 and the rest solved again.

@@ -24,6 +24,9 @@ namespace avatarbooth {
 struct CharacterControl {
     std::vector<std::string_view> modifiers;  // names in the basis ("eyes/r-eye-size-big", ...)
     std::string_view purpose;                 // the quantity it is there for ("r2", ...), for the report
+    // Times the solve's regularisation: the head's scale moves every ratio at once (they are all over the face
+    // width), so it is held firmly, for the face aspect, not as a lever on the parts the other sliders cannot reach.
+    double firmness = 1.0;
 };
 
 // The controls, in the order of the solve's unknowns: the two ends of each MakeHuman slider as controls 2k (the
@@ -42,6 +45,7 @@ struct CharacterModel {
     std::vector<std::vector<std::size_t>> controlModifiers;  // basis indices per control
     std::vector<QuantityVector> jacobian;                    // per control: d quantity / d weight
     std::vector<glm::dvec3> earHoleShift;                    // per control: the ear hole's move at weight 1
+    std::vector<double> firmness;                            // per control (CharacterControl::firmness); empty: 1
     double pxPerMm = 4.0;
 };
 
