@@ -314,8 +314,8 @@ std::vector<ConfigTable> makeTables() {
                  }});
     t.push_back({.name = "animation", .doc = "The avatar's turn on the reveal and attract screens."});
     t.push_back({.name = "character",
-                 .doc = "The character avatar: a stylised head made from the base head, its face parts moved "
-                        "and scaled to the visitor's proportions (Narita); written as character.json + character.glb "
+                 .doc = "The character avatar: the base head with MakeHuman's own sliders set to the visitor's "
+                        "proportions (Narita), in a flat toon skin; written as character.json + character.glb "
                         "in every session when enabled."});
     t.push_back({.name = "reveal", .doc = "The avatar styles on the reveal and attract screens."});
     t.push_back({.name = "stage", .doc = "Kitamura's tile stage under the avatars on the attract and reveal screens."});

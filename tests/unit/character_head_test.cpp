@@ -1,11 +1,14 @@
-// The character head: its parts follow the proportions it is given (measured back the way a photo is), a bigger
-// eye ratio gives measurably bigger eyes, exaggeration and clamping, the toon texture, colours from a photo.
+// The character head without MakeHuman's modifiers (the built-in head: the base head itself, with a warning),
+// exaggeration and clamping of the target, the toon texture and its tint, colours from a photo. The character on
+// the MakeHuman head (its modifiers) is tests/data/character_makehuman_data_test.cpp.
 #include "reveal/character/character_head.h"
-#include "common/landmark_names.h"
+#include "fit/head/surface_texels.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <string>
 
 namespace avatarbooth {
 namespace {
@@ -24,75 +27,23 @@ const CharacterProportions& baseProportions() {
     return p;
 }
 
-glm::dvec3 featureOf(const Mesh& mesh, int k) {
-    return mesh.positions[builtinBaseHead().frontFeatures.at(landmarkName(k))];
-}
-
-void expectMeasures(const CharacterProportions& achieved, const CharacterProportions& target) {
-    for (std::size_t i = 0; i < 8; ++i) EXPECT_NEAR(achieved.r[i], target.r[i], 0.004) << "r" << i;
-    EXPECT_NEAR(achieved.eyeSpacing, target.eyeSpacing, 0.004);
-    EXPECT_NEAR(achieved.eyeTiltDeg, target.eyeTiltDeg, 0.5);
-    EXPECT_NEAR(achieved.browTiltDeg, target.browTiltDeg, 0.5);
-}
-
-TEST(CharacterHead, EveryPartFollowsItsParameter) {
+TEST(CharacterHead, WithoutAModifierBasisTheCharacterIsTheBaseHead) {
+    // The built-in head has no MakeHuman modifiers: the character keeps its shape, says so, and is still painted.
     CharacterProportions target = baseProportions();
-    target.r[0] = 1.45;
     target.r[2] = 0.19;
-    target.r[3] = 0.16;
-    target.r[4] = 0.30;
-    target.r[5] = 0.17;
-    target.r[6] = 0.25;
-    target.r[7] = 0.42;
-    target.eyeSpacing = 0.40;
-    target.eyeTiltDeg = 8.0;
-    target.browTiltDeg = 10.0;
-    const CharacterHead up = makeCharacterHead(builtinBaseHead(), target, quick());
-    expectMeasures(up.target, target);
-    expectMeasures(up.achieved, target);
-
-    target = baseProportions();
-    target.r[0] = 1.15;
-    target.r[2] = 0.11;
-    target.r[3] = 0.08;
-    target.r[4] = 0.38;
-    target.r[5] = 0.10;
-    target.r[6] = 0.19;
-    target.r[7] = 0.33;
-    target.eyeSpacing = 0.32;
-    target.eyeTiltDeg = -6.0;
-    target.browTiltDeg = -15.0;
-    expectMeasures(makeCharacterHead(builtinBaseHead(), target, quick()).achieved, target);
-}
-
-TEST(CharacterHead, ABiggerEyeRatioGivesBiggerEyes) {
-    CharacterProportions small = baseProportions(), big = baseProportions();
-    small.r[2] = 0.8 * baseProportions().r[2];
-    big.r[2] = 1.3 * baseProportions().r[2];
-    const CharacterHead a = makeCharacterHead(builtinBaseHead(), small, quick());
-    const CharacterHead b = makeCharacterHead(builtinBaseHead(), big, quick());
-    const auto eyeWidth = [](const Mesh& m) {
-        return 0.5 * (glm::distance(glm::dvec2(featureOf(m, 36)), glm::dvec2(featureOf(m, 39))) +
-                      glm::distance(glm::dvec2(featureOf(m, 42)), glm::dvec2(featureOf(m, 45))));
-    };
-    const auto eyeHeight = [](const Mesh& m) { return featureOf(m, 37).y - featureOf(m, 41).y; };
-    // The face width barely changes, so the eyes' width grows by about 1.3 / 0.8.
-    EXPECT_NEAR(eyeWidth(b.mesh) / eyeWidth(a.mesh), 1.3 / 0.8, 0.05);
-    EXPECT_GT(eyeHeight(b.mesh), 1.4 * eyeHeight(a.mesh));
-    EXPECT_NEAR(b.achieved.r[2] / a.achieved.r[2], 1.3 / 0.8, 0.02);
-}
-
-TEST(CharacterHead, TheBaseHeadsOwnProportionsLeaveItAsItIs) {
-    const CharacterHead same = makeCharacterHead(builtinBaseHead(), baseProportions(), quick());
-    double worst = 0.0;
-    for (std::size_t v = 0; v < same.mesh.positions.size(); ++v)
-        worst = std::max(worst, glm::distance(same.mesh.positions[v], builtinBaseHead().mesh.positions[v]));
-    EXPECT_LT(worst, 0.5);  // millimetres
+    const CharacterHead same = makeCharacterHead(builtinBaseHead(), target, quick());
+    EXPECT_EQ(same.mesh.positions, builtinBaseHead().mesh.positions);
     EXPECT_EQ(same.mesh.triangles, builtinBaseHead().mesh.triangles);
     EXPECT_EQ(same.mesh.uvs, builtinBaseHead().mesh.uvs);
+    EXPECT_TRUE(same.modifiers.empty());
+    ASSERT_EQ(same.warnings.size(), 1u);
+    EXPECT_NE(same.warnings[0].find("no modifier basis"), std::string::npos);
+    EXPECT_DOUBLE_EQ(same.target.r[2], 0.19);
+    EXPECT_DOUBLE_EQ(same.achieved.r[2], baseProportions().r[2]);
+    EXPECT_EQ(same.texture.size(), cv::Size(64, 64));
 }
 
-TEST(CharacterHead, ExaggerationAndClamping) {
+TEST(CharacterHead, ExaggerationAndClampingOfTheTarget) {
     CharacterProportions wanted = baseProportions();
     wanted.r[6] = baseProportions().r[6] + 0.03;
     wanted.r[2] = 5.0;  // far outside the slider range
@@ -101,7 +52,9 @@ TEST(CharacterHead, ExaggerationAndClamping) {
     const CharacterHead h = makeCharacterHead(builtinBaseHead(), wanted, s);
     EXPECT_NEAR(h.target.r[6], baseProportions().r[6] + 0.06, 1e-12);
     EXPECT_DOUBLE_EQ(h.target.r[2], 0.22);  // clamped to the eye_size slider's top
-    EXPECT_NEAR(h.achieved.r[6], h.target.r[6], 0.004);
+    // A slider left out keeps the base head's value.
+    s.sliders = std::set<std::string>{"eye_size"};
+    EXPECT_DOUBLE_EQ(makeCharacterHead(builtinBaseHead(), wanted, s).target.r[6], baseProportions().r[6]);
 }
 
 TEST(CharacterHead, ToonTextureUsesTheLooksFlatColours) {
@@ -122,6 +75,34 @@ TEST(CharacterHead, ToonTextureUsesTheLooksFlatColours) {
     EXPECT_GT(skin / n, 0.3);
     EXPECT_GT(hair / n, 0.15);
     EXPECT_GT(other, 0);  // eyes, brows, lips, blush
+}
+
+TEST(CharacterHead, ToonSkinIsTintedByTheSkinColour) {
+    // A toon skin of two halves: white (toon01's own colour) and mid grey. The skin colour multiplies it.
+    cv::Mat toon(128, 128, CV_8UC3, cv::Scalar(255, 255, 255));
+    toon.colRange(64, 128).setTo(cv::Scalar(128, 128, 128));
+    CharacterLook look;
+    look.skin = cv::Scalar(100, 150, 200);
+    const cv::Mat tex = paintCharacterTexture(builtinBaseHead(), 128, look, toon);
+    const cv::Mat plain = paintCharacterTexture(builtinBaseHead(), 128, look);
+    const Mesh& mesh = builtinBaseHead().mesh;
+    const cv::Mat covered = sampleSurfaceTexels(mesh, mesh.vertexNormals(), tex.size()).covered;
+    int white = 0, grey = 0;
+    for (int y = 0; y < tex.rows; ++y)
+        for (int x = 0; x < tex.cols; ++x) {
+            // Skin texels only: not the painted parts, nor the border padding (which mixes its neighbours).
+            if (!covered.at<unsigned char>(y, x) || plain.at<cv::Vec3b>(y, x) != cv::Vec3b(100, 150, 200)) continue;
+            const cv::Vec3b c = tex.at<cv::Vec3b>(y, x);
+            if (x < 64) {
+                EXPECT_EQ(c, cv::Vec3b(100, 150, 200)) << x << "," << y;
+                ++white;
+            } else {
+                EXPECT_EQ(c, cv::Vec3b(50, 75, 100)) << x << "," << y;  // 128/255 of it, rounded
+                ++grey;
+            }
+        }
+    EXPECT_GT(white, 100);
+    EXPECT_GT(grey, 100);
 }
 
 TEST(CharacterHead, ColoursFromAPhoto) {

@@ -173,9 +173,9 @@ TEST(CharacterProportions, JsonHoldsPointsRatiosAndSliders) {
     EXPECT_DOUBLE_EQ(j["lengths_px"]["l_f1"].get<double>(), 120.0);
     EXPECT_DOUBLE_EQ(j["ratios"]["r4"].get<double>(), 0.37);
     EXPECT_DOUBLE_EQ(j["extras"]["eye_spacing"].get<double>(), 0.4);
-    EXPECT_DOUBLE_EQ(j["sliders"]["face_aspect"]["value"].get<double>(), 0.4);
-    EXPECT_EQ(j["sliders"]["face_aspect"]["range"], nlohmann::json({0.8, 1.8}));
-    EXPECT_EQ(j["sliders"].size(), 11u);
+    EXPECT_DOUBLE_EQ(j["narita_sliders"]["face_aspect"]["value"].get<double>(), 0.4);
+    EXPECT_EQ(j["narita_sliders"]["face_aspect"]["range"], nlohmann::json({0.8, 1.8}));
+    EXPECT_EQ(j["narita_sliders"].size(), 11u);
     EXPECT_EQ(j["point_sources"]["Pa2, Pa3"], "left ear top and bottom: canon (points on the silhouette, face contour)");
     EXPECT_EQ(j["warnings"].size(), 1u);
 }

@@ -613,10 +613,19 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
         const fs::path material = entry.path() / (name + ".json");
         if (!entry.is_directory() || !fs::is_regular_file(material)) continue;
         const nlohmann::json j = readJson(material);
-        if (!j.contains("mapDiffuse") || !j["mapDiffuse"].is_string()) continue;  // a flat colour (default, toon01)
-        const fs::path file = entry.path() / j["mapDiffuse"].get<std::string>();
-        const cv::Mat atlasImage = readPhoto(file);
-        out.skins[name] = layOut(atlasImage);
+        if (j.contains("mapDiffuse") && j["mapDiffuse"].is_string()) {
+            const fs::path file = entry.path() / j["mapDiffuse"].get<std::string>();
+            out.skins[name] = layOut(readPhoto(file));
+        } else if (j.contains("colorDiffuse") && j["colorDiffuse"].is_array() && j["colorDiffuse"].size() == 3) {
+            // A flat colour (toon01, the character's skin): that colour laid out the same way.
+            cv::Scalar bgr;
+            for (int ch = 0; ch < 3; ++ch) {
+                const auto& c = j["colorDiffuse"][static_cast<std::size_t>(2 - ch)];
+                if (!c.is_number()) throw BoothError(ErrorKind::BadConfig, material.string(), "colorDiffuse is not three numbers");
+                bgr[ch] = std::clamp(c.get<double>(), 0.0, 1.0) * 255.0;
+            }
+            out.skins[name] = layOut(cv::Mat(16, 16, CV_8UC3, bgr));
+        }
     }
     if (ec) throw BoothError(ErrorKind::BadConfig, skinsDir.string(), "cannot be listed: " + ec.message());
     const auto chosen = out.skins.find(options.skin);

@@ -30,7 +30,9 @@ struct MakeHumanHead {
     BaseHead head;       // mesh in millimetres, ear-hole centre at the origin
     ModifierBasis basis;
     cv::Mat skin;        // BGR, textureSize square: the chosen skin laid out on the head's UVs
-    std::map<std::string, cv::Mat> skins;  // every MakeHuman skin with a texture, laid out likewise (by folder name)
+    // Every MakeHuman skin laid out likewise, by folder name: the textured ones and the flat-colour toon01 (the
+    // character's skin).
+    std::map<std::string, cv::Mat> skins;
     std::vector<std::uint32_t> sourceVertex;  // for each head vertex, its hm08 vertex (the eyes' and the cap's too)
 };
 

@@ -1,16 +1,18 @@
-// The character avatar: measure the base head like a photo, move its parts by smooth bones towards the target
-// proportions, repeat; paint a flat toon texture.
+// The character avatar: MakeHuman's modifiers solved for the target proportions, measured like a photo; a flat
+// toon texture.
 #include "reveal/character/character_head.h"
 
+#include "reveal/character/character_modifiers.h"
 #include "common/error.h"
+#include "common/image_io.h"
 #include "common/landmark_names.h"
 #include "fit/head/surface_texels.h"
 
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
-#include <functional>
 #include <limits>
 
 namespace avatarbooth {
@@ -18,55 +20,11 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// 1 at x <= 0, 0 at x >= 1, smooth (C1) in between.
-double fadeOut(double x) {
-    x = std::clamp(x, 0.0, 1.0);
-    return 1.0 - x * x * (3.0 - 2.0 * x);
-}
-// 0 at v <= lo, 1 at v >= lo + ramp.
-double fadeIn(double v, double lo, double ramp) { return 1.0 - fadeOut((v - lo) / ramp); }
-// 1 inside [lo, hi], fading to 0 over `margin` outside.
-double band(double v, double lo, double hi, double margin) {
-    const double outside = v < lo ? lo - v : (v > hi ? v - hi : 0.0);
-    return fadeOut(outside / margin);
-}
-
 glm::dvec2 xy(const glm::dvec3& p) { return {p.x, p.y}; }
-glm::dvec2 rotate(const glm::dvec2& v, double radians) {
-    const double c = std::cos(radians), s = std::sin(radians);
-    return {c * v.x - s * v.y, s * v.x + c * v.y};
-}
-
 double distanceToSegment(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b) {
     const glm::dvec2 ab = b - a;
     const double t = std::clamp(glm::dot(p - a, ab) / std::max(glm::dot(ab, ab), 1e-12), 0.0, 1.0);
     return glm::distance(p, a + t * ab);
-}
-
-// A displacement of head space in the front plane (x, y); depth is kept.
-using Bone = std::function<glm::dvec2(const glm::dvec3&)>;
-
-// Points of a Narita mapping in millimetres (front plane).
-struct PointsMm {
-    std::array<glm::dvec2, 3> f;
-    std::array<glm::dvec2, 10> e;
-    std::array<glm::dvec2, 4> a;
-    std::array<glm::dvec2, 2> b, browOuter;
-    glm::dvec2 n, m;
-};
-
-PointsMm toMm(const NaritaPoints& P, const MeshFrontView& view) {
-    PointsMm out;
-    for (std::size_t i = 0; i < 3; ++i) out.f[i] = view.toMm(P.f[i]);
-    for (std::size_t i = 0; i < 10; ++i) out.e[i] = view.toMm(P.e[i]);
-    for (std::size_t i = 0; i < 4; ++i) out.a[i] = view.toMm(P.a[i]);
-    for (std::size_t i = 0; i < 2; ++i) {
-        out.b[i] = view.toMm(P.b[i]);
-        out.browOuter[i] = view.toMm(P.browOuter[i]);
-    }
-    out.n = view.toMm(P.n);
-    out.m = view.toMm(P.m);
-    return out;
 }
 
 glm::dvec3 feature(const Mesh& mesh, const BaseHead& base, int k) {
@@ -77,27 +35,6 @@ glm::dvec3 featureMean(const Mesh& mesh, const BaseHead& base, int from, int to)
     glm::dvec3 sum(0.0);
     for (int k = from; k <= to; ++k) sum += feature(mesh, base, k);
     return sum / static_cast<double>(to - from + 1);
-}
-
-// An elliptic part (eye, nose, mouth): inside the ellipse every point takes the part's full motion (translation
-// `shift` plus the linear map `A` about the centre); outside it the motion of the nearest boundary point fades to
-// nothing at `outer` ellipse radii. `outer` grows with the motion so that the fade never folds the surface (a
-// smoothstep fade over a margin m folds once the displacement exceeds m / 1.5).
-Bone ellipticPart(glm::dvec2 centre, double ax, double ay, glm::dvec2 shift, glm::dmat2 A, double zFront,
-                  double zRamp) {
-    const double linearReach = std::max(std::abs(A[0][0]) + std::abs(A[1][0]), std::abs(A[0][1]) + std::abs(A[1][1]));
-    const double motion = glm::length(shift) / std::min(ax, ay) + linearReach;
-    const double outer = std::max(1.8, 1.0 + 1.6 * motion);
-    return [=](const glm::dvec3& p) -> glm::dvec2 {
-        const double gate = fadeIn(p.z, zFront, zRamp);
-        if (gate <= 0.0) return {0.0, 0.0};
-        const glm::dvec2 q = xy(p) - centre;
-        const double rho = std::sqrt((q.x / ax) * (q.x / ax) + (q.y / ay) * (q.y / ay));
-        if (rho >= outer) return {0.0, 0.0};
-        if (rho <= 1.0) return gate * (shift + A * q);
-        const double fade = fadeOut((rho - 1.0) / (outer - 1.0));
-        return gate * fade * (shift + A * (q / rho));
-    };
 }
 
 }  // namespace
@@ -156,125 +93,67 @@ CharacterHead makeCharacterHead(const BaseHead& base, const CharacterProportions
                               applied ? b + settings.exaggeration * (proportionQuantity(wanted, s.quantity) - b) : b);
     }
     out.target = target = clampToSliderRanges(target);
-    const double eyeDistance = glm::distance(xy(featureMean(base.mesh, base, 36, 41)), xy(featureMean(base.mesh, base, 42, 47)));
-
-    for (int round = 0; round < settings.correctionRounds; ++round) {
-        const MeasuredHead now = measureHead(out.mesh, base, out.earHole, settings.pxPerMm);
-        const CharacterProportions& cur = now.proportions;
-        PointsMm P = toMm(now.mapping.points, now.view);
-        const double W = glm::distance(P.f[0], P.f[1]);
-        const double yF = 0.5 * (P.f[0].y + P.f[1].y);
-
-        // Face aspect: the whole head scales vertically about the face line.
-        const double s = target.r[0] / cur.r[0];
-        const auto scaleY = [&](double y) { return yF + (y - yF) * s; };
-        for (auto& p : out.mesh.positions) p.y = scaleY(p.y);
-        out.earHole.y = scaleY(out.earHole.y);
-        for (auto& q : P.e) q.y = scaleY(q.y);
-        for (auto& q : P.a) q.y = scaleY(q.y);
-        for (std::size_t i = 0; i < 2; ++i) {
-            P.b[i].y = scaleY(P.b[i].y);
-            P.browOuter[i].y = scaleY(P.browOuter[i].y);
-        }
-        P.n.y = scaleY(P.n.y);
-        P.m.y = scaleY(P.m.y);
-
-        std::vector<Bone> bones;
-        // Eyes: position along the face line (r1 and spacing), size (r2) and tilt about their centres.
-        const double k = target.r[2] / cur.r[2];
-        const double dTilt = (target.eyeTiltDeg - cur.eyeTiltDeg) * kPi / 180.0;
-        const std::array<double, 2> alongTarget = {target.r[1] * W - 0.5 * target.eyeSpacing * W,
-                                                   target.r[1] * W + 0.5 * target.eyeSpacing * W};
-        for (std::size_t side = 0; side < 2; ++side) {
-            glm::dvec2 c(0.0);
-            for (std::size_t i = 5 * side; i < 5 * side + 5; ++i) c += P.e[i];
-            c /= 5.0;
-            const double angle = side == 0 ? -dTilt : dTilt;  // the right eye's outer corner is at -x
-            const glm::dmat2 R(std::cos(angle), std::sin(angle), -std::sin(angle), std::cos(angle));
-            const glm::dmat2 A = k * R - glm::dmat2(1.0);
-            const glm::dvec2 shift(P.f[0].x + alongTarget[side] - c.x, 0.0);
-            const double zEye = side == 0 ? featureMean(out.mesh, base, 36, 41).z : featureMean(out.mesh, base, 42, 47).z;
-            bones.push_back(ellipticPart(c, 0.28 * eyeDistance, 0.2 * eyeDistance, shift, A, zEye - 0.5 * eyeDistance,
-                                         0.2 * eyeDistance));
-        }
-        // Brows: the inner end's height (r5), turned about the inner end (brow tilt).
-        const double dBrow = (target.browTiltDeg - cur.browTiltDeg) * kPi / 180.0;
-        for (std::size_t side = 0; side < 2; ++side) {
-            std::vector<glm::dvec2> line;
-            for (int kk = side == 0 ? 17 : 22; kk <= (side == 0 ? 21 : 26); ++kk) {
-                const glm::dvec3 v = feature(out.mesh, base, kk);
-                line.emplace_back(v.x, v.y);
-            }
-            const double zBrow = feature(out.mesh, base, side == 0 ? 19 : 24).z;
-            const glm::dvec2 inner = P.b[side];
-            const double dy = yF + target.r[5] * W - inner.y;
-            const double angle = side == 0 ? -dBrow : dBrow;
-            const double length = glm::distance(P.b[side], P.browOuter[side]);
-            const double core = 0.08 * eyeDistance;
-            const double margin = std::max(0.2 * eyeDistance, 1.6 * (std::abs(dy) + std::abs(angle) * length));
-            bones.push_back([=](const glm::dvec3& p) -> glm::dvec2 {
-                const double gate = fadeIn(p.z, zBrow - 0.5 * eyeDistance, 0.2 * eyeDistance);
-                if (gate <= 0.0) return {0.0, 0.0};
-                const glm::dvec2 q = xy(p);
-                double d = std::numeric_limits<double>::max();
-                for (std::size_t i = 0; i + 1 < line.size(); ++i) d = std::min(d, distanceToSegment(q, line[i], line[i + 1]));
-                const double w = d <= core ? 1.0 : fadeOut((d - core) / margin);
-                return gate * w * (inner + rotate(q - inner, angle) - q + glm::dvec2(0.0, dy));
-            });
-        }
-        // Nose tip (r6) and mouth (r7): vertical moves below the face line.
-        const glm::dvec3 noseTip = feature(out.mesh, base, 30);
-        bones.push_back(ellipticPart(P.n, 0.3 * eyeDistance, 0.2 * eyeDistance,
-                                     {0.0, yF - target.r[6] * W - P.n.y}, glm::dmat2(0.0), noseTip.z - 0.8 * eyeDistance,
-                                     0.2 * eyeDistance));
-        const double mouthHalf = 0.5 * glm::distance(xy(feature(out.mesh, base, 48)), xy(feature(out.mesh, base, 54)));
-        const double zMouth = featureMean(out.mesh, base, 48, 59).z;
-        bones.push_back(ellipticPart(P.m, mouthHalf + 0.1 * eyeDistance, 0.18 * eyeDistance,
-                                     {0.0, yF - target.r[7] * W - P.m.y}, glm::dmat2(0.0), zMouth - 0.6 * eyeDistance,
-                                     0.2 * eyeDistance));
-        // Ears: the top to its height (r3), stretched about the top to the length (r4).
-        std::array<std::function<double(double)>, 2> earMaps;
-        for (std::size_t side = 0; side < 2; ++side) {
-            const glm::dvec2 top = P.a[2 * side], bottom = P.a[2 * side + 1];
-            const double above = top.y >= yF ? 1.0 : -1.0;
-            const double topTarget = yF + above * target.r[3] * W;
-            const double stretch = (target.r[4] * W) / std::max(top.y - bottom.y, 1e-6);
-            const auto map = [=](double y) { return topTarget + stretch * (y - top.y); };
-            earMaps[side] = map;
-            // The ear's outermost vertex between its notches tells where it is in depth and how far it reaches.
-            const double sign = side == 0 ? -1.0 : 1.0;
-            glm::dvec3 outer(0.0);
-            for (const auto& p : out.mesh.positions)
-                if (p.y <= top.y && p.y >= bottom.y && sign * p.x > sign * outer.x) outer = p;
-            // The notches are where the ear meets the head's outline: the region reaches in past them, so that
-            // they move with the ear (the side of the head there slides vertically, which leaves its shape).
-            const double attach = std::min(std::abs(top.x), std::abs(bottom.x)) - 0.15 * eyeDistance;
-            const double maxMove = std::max(std::abs(map(top.y) - top.y), std::abs(map(bottom.y) - bottom.y));
-            const double yMargin = std::max(0.15 * eyeDistance, 1.6 * maxMove);
-            bones.push_back([=](const glm::dvec3& p) -> glm::dvec2 {
-                if (sign * p.x <= 0.0) return {0.0, 0.0};
-                const double w = fadeIn(std::abs(p.x), attach, 0.1 * eyeDistance) *
-                                 band(p.y, bottom.y, top.y, yMargin) *
-                                 band(p.z, outer.z - 0.3 * eyeDistance, outer.z + 0.2 * eyeDistance, 0.15 * eyeDistance);
-                return {0.0, w * (map(p.y) - p.y)};
-            });
-        }
-
-        std::vector<glm::dvec2> moves(out.mesh.positions.size(), glm::dvec2(0.0));
-        for (std::size_t v = 0; v < out.mesh.positions.size(); ++v)
-            for (const Bone& bone : bones) moves[v] += bone(out.mesh.positions[v]);
-        for (std::size_t v = 0; v < out.mesh.positions.size(); ++v) {
-            out.mesh.positions[v].x += moves[v].x;
-            out.mesh.positions[v].y += moves[v].y;
-        }
-        out.earHole.y = 0.5 * (earMaps[0](out.earHole.y) + earMaps[1](out.earHole.y));
+    out.texture = paintCharacterTexture(base, settings.textureSize, look, base.modifiers ? makeHumanToonSkin() : cv::Mat());
+    if (!base.modifiers) {
+        out.achieved = out.base;
+        static const std::string kNoBasis = "the base head has no modifier basis: the character keeps its proportions";
+        out.warnings.push_back(kNoBasis);
+        return out;
     }
-    out.achieved = measureHead(out.mesh, base, out.earHole, settings.pxPerMm).proportions;
-    out.texture = paintCharacterTexture(base, settings.textureSize, look);
+
+    const ModifierBasis& basis = *base.modifiers;
+    CharacterModel model = characterModelOf(base, settings.pxPerMm);
+    const auto misfit = [&](const CharacterProportions& p) {
+        double sum = 0.0;
+        const QuantityVector q = quantitiesOf(p), t = quantitiesOf(target);
+        for (std::size_t i = 0; i < kCharacterQuantities; ++i) {
+            const double d = (q[i] - t[i]) / (sliderRanges()[i].hi - sliderRanges()[i].lo);
+            sum += d * d;
+        }
+        return sum;
+    };
+    // Gauss-Newton over the weights: each round a bounded least-squares step with the Jacobian where the head is,
+    // halved while the head it gives measures worse (the silhouette's measures are not smooth: an ear's notch can
+    // jump).
+    std::vector<double> weights(model.jacobian.size(), 0.0);
+    CharacterProportions now = model.base;
+    for (int round = 0; round < settings.correctionRounds; ++round) {
+        if (round > 0) remeasureJacobian(model, base, weights, now);
+        const std::vector<double> full = solveCharacterStep(model, weights, now, target);
+        bool better = false;
+        for (double t = 1.0; t >= 1.0 / 16.0 && !better; t *= 0.5) {
+            std::vector<double> next(weights.size());
+            for (std::size_t c = 0; c < next.size(); ++c) next[c] = weights[c] + t * (full[c] - weights[c]);
+            const CharacterProportions measured = measureCharacter(model, base, next);
+            if (misfit(measured) < misfit(now)) {
+                weights = next;
+                now = measured;
+                better = true;
+            }
+        }
+        if (!better) break;
+    }
+    const CharacterShape shape = characterShape(model, base, weights);
+    out.mesh.positions = shape.positions;
+    out.earHole = shape.earHole;
+    out.achieved = now;
+    const std::vector<double> all = basisWeights(model, basis.modifiers.size(), weights);
+    for (const auto& ks : model.controlModifiers)
+        for (const std::size_t k : ks) out.modifiers.emplace_back(basis.modifiers[k].name, all[k]);
     return out;
 }
 
-cv::Mat paintCharacterTexture(const BaseHead& base, int textureSize, const CharacterLook& look) {
+const cv::Mat& makeHumanToonSkin() {
+    static const cv::Mat skin = [] {
+        const std::filesystem::path dir = findMakeHumanBaseHead();
+        const std::filesystem::path file = dir / "skins" / "toon01.jpg";
+        if (dir.empty() || !std::filesystem::is_regular_file(file)) return cv::Mat();
+        return readPhoto(file);
+    }();
+    return skin;
+}
+
+cv::Mat paintCharacterTexture(const BaseHead& base, int textureSize, const CharacterLook& look, const cv::Mat& toonSkin) {
     const Mesh& mesh = base.mesh;
     const SurfaceTexels texels = sampleSurfaceTexels(mesh, mesh.vertexNormals(), cv::Size(textureSize, textureSize));
     std::array<glm::dvec2, 68> lm;
@@ -301,9 +180,19 @@ cv::Mat paintCharacterTexture(const BaseHead& base, int textureSize, const Chara
     const cv::Vec3b white(250, 250, 250), ink(30, 25, 30), brow = colour(look.hair * 0.7);
     const cv::Vec3b blush = colour(look.skin * 0.6 + cv::Scalar(90, 90, 255) * 0.4), mouthLine = colour(look.lips * 0.55);
 
-    cv::Mat texture = paintTexels(texels, [&](const glm::dvec3& p, const cv::Vec3f& nf) {
+    // The skin layer: toon01 on the head's UVs tinted by the skin colour (a plain white toon01 gives the skin itself).
+    cv::Mat toon;
+    if (!toonSkin.empty()) cv::resize(toonSkin, toon, cv::Size(textureSize, textureSize), 0.0, 0.0, cv::INTER_AREA);
+    const auto skinAt = [&](int x, int y) {
+        if (toon.empty()) return skin;
+        const cv::Vec3b t = toon.at<cv::Vec3b>(y, x);
+        cv::Vec3b out;
+        for (int ch = 0; ch < 3; ++ch) out[ch] = cv::saturate_cast<unsigned char>(t[ch] * look.skin[ch] / 255.0);
+        return out;
+    };
+    const auto paint = [&](const glm::dvec3& p, const cv::Vec3f& nf, const cv::Vec3b& skinHere) {
         const glm::dvec2 q(p.x, p.y);
-        cv::Vec3b c = skin;
+        cv::Vec3b c = skinHere;
         // Hair: a cap whose edge is high on the forehead, comes down over the temples above the ears and to the
         // nape at the back (by the direction around the head, 0 = the face).
         const double azimuth = std::abs(std::atan2(p.x, p.z)) * 180.0 / kPi;
@@ -347,7 +236,14 @@ cv::Mat paintCharacterTexture(const BaseHead& base, int textureSize, const Chara
             if (lipShape < 0.7) c = std::abs(mm.y) < 0.05 ? mouthLine : lips;
         }
         return c;
-    });
+    };
+    cv::Mat texture(texels.covered.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+    for (int y = 0; y < texture.rows; ++y)
+        for (int x = 0; x < texture.cols; ++x) {
+            if (!texels.covered.at<unsigned char>(y, x)) continue;
+            const cv::Vec3f pf = texels.position.at<cv::Vec3f>(y, x);
+            texture.at<cv::Vec3b>(y, x) = paint(glm::dvec3(pf[0], pf[1], pf[2]), texels.normal.at<cv::Vec3f>(y, x), skinAt(x, y));
+        }
     padTextureBorders(texture, texels.covered, 6);
     return texture;
 }

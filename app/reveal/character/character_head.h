@@ -1,16 +1,13 @@
-// The character avatar: a stylised head made from the base head whose face parts are moved and scaled to given
-// Narita proportions (the thesis' parametric deformation, as a game's character maker does with its sliders),
-// with a flat, toon-like painted texture instead of the photos.
+// The character avatar: the base head with MakeHuman's own modifiers set so that it measures given Narita
+// proportions (the thesis' character maker, with the model's own sliders), with a flat toon texture instead of the
+// photos: MakeHuman's toon01 skin tinted by the visitor's colours, with painted eyes, brows, mouth and hair.
 //
-// How the parts move (front view, x to the subject's left, y up; depth is kept): the whole head is scaled
-// vertically about the face line to the face aspect r0; then each part is a small "bone" with a smooth weight
-// over the vertices around it (1 on the part, easing to 0 over a margin, front surface only): the eyes move
-// along the face line (r1 and the eye spacing) and scale about their centres (r2) and turn (eye tilt); the brows
-// move to their height (r5) and turn about their inner ends (brow tilt); nose (r6) and mouth (r7) move vertically;
-// each ear moves to its height (r3) and stretches vertically about its top (r4). The head is measured exactly as
-// a photo is (its orthographic front silhouette and projected feature vertices through mapNaritaPoints), the
-// parts are corrected by what is still missing, and this is repeated a few times, so the finished character
-// measures the proportions it was asked for.
+// How the weights are found (character_modifiers.h): the base head is measured exactly as a photo is (its
+// orthographic front silhouette and projected feature vertices through mapNaritaPoints); each control (a modifier,
+// or a right and left pair) is measured the same way at half weight, which gives the Jacobian of the 11 quantities;
+// then a bounded least-squares step over the weights, the head made and measured again, and the step repeated on
+// what is still missing, so that the finished character measures the proportions it was asked for as closely as
+// MakeHuman's slider ranges allow.
 #pragma once
 
 #include "reveal/character/narita_points.h"
@@ -20,6 +17,8 @@
 #include <opencv2/core.hpp>
 
 #include <optional>
+#include <utility>
+#include <vector>
 #include <set>
 #include <string>
 
@@ -36,7 +35,7 @@ struct CharacterLook {
 struct CharacterSettings {
     int textureSize = 512;      // edge of the square painted texture, in texels (flat colours need few)
     double exaggeration = 1.0;  // 1: the given proportions; above 1 pushes each away from the base head's (caricature)
-    int correctionRounds = 4;   // measure-and-correct rounds of the deformation
+    int correctionRounds = 4;   // measure-and-solve rounds of the modifier weights
     double pxPerMm = 4.0;       // resolution of the silhouette the head is measured on
     // The sliders (SliderRange::key) that move the character's parts; a slider left out keeps the base head's
     // value, so an operator can keep, say, the eyes generic and play only with the face shape. Unset: all of them.
@@ -74,15 +73,27 @@ struct CharacterHead {
     CharacterProportions achieved; // what the finished head measures
     CharacterProportions base;     // what the base head measures
     glm::dvec3 earHole{0.0};       // the base head's ear-hole centre after the deformation
+    // The model's own sliders: every modifier the character drives, by its name in the basis, with its weight in
+    // [0, 1] (MakeHuman's one-sided targets: "nose/nose-trans-up" and "nose/nose-trans-down" are two).
+    std::vector<std::pair<std::string, double>> modifiers;
+    std::vector<std::string> warnings;  // e.g. a base head without a modifier basis (the character is that head)
 };
 
-// Builds the character for `target` (clamped to the slider ranges first, so a wild measurement cannot tear the
-// mesh). Throws BoothError(Internal) when the base head cannot be measured (no eyes or brows in its features).
+// Builds the character for `target` (exaggerated and clamped to the slider ranges first). A base head without a
+// modifier basis (the small built-in one, an operator's own) gives the base head itself, with a warning. Throws
+// BoothError(Internal) when the base head cannot be measured (no eyes or brows in its features).
 CharacterHead makeCharacterHead(const BaseHead& base, const CharacterProportions& target,
                                 const CharacterSettings& settings = {}, const CharacterLook& look = {});
 
-// The flat toon texture for the base head's UV layout (depends only on the base head and the colours).
-cv::Mat paintCharacterTexture(const BaseHead& base, int textureSize, const CharacterLook& look);
+// The flat toon texture for the base head's UV layout (depends only on the base head and the colours): `toonSkin`
+// (MakeHuman's toon01 on the head's UVs, any size; empty: plain white, toon01's own diffuse colour) tinted by the
+// skin colour, with the hair cap, brows, eyes, blush and mouth painted over it.
+cv::Mat paintCharacterTexture(const BaseHead& base, int textureSize, const CharacterLook& look,
+                              const cv::Mat& toonSkin = cv::Mat());
+
+// MakeHuman's toon01 skin laid out on the MakeHuman base head's UVs (skins/toon01.jpg beside the base head, which
+// the build writes); empty when there is none. Read once.
+const cv::Mat& makeHumanToonSkin();
 
 // Skin and hair colours from the front photo: the median colour of two cheek patches, and of the silhouette over
 // the top of the head (above the brow line by 1.2-1.5 times the brow-to-nose-base height); defaults where there

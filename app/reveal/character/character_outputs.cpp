@@ -1,6 +1,7 @@
 // character.json and character.glb from a fit's front-photo analysis.
 #include "reveal/character/character_outputs.h"
 
+#include "reveal/character/character_modifiers.h"
 #include "fit/export/glb.h"
 
 #include <chrono>
@@ -45,14 +46,30 @@ CharacterOutputs makeCharacterOutputs(const cv::Mat& frontPhoto, const std::arra
         ratios["brow_tilt_deg"] = value->browTiltDeg;
         character[name] = ratios;
     }
-    character["note"] = "target: the measured proportions clamped to the slider ranges; achieved: what the character "
-                        "head measures (front silhouette and feature vertices, the same mapping as the photo)";
+    // The model's own sliders: MakeHuman's modifiers on the base head, by their names in its basis.
+    nlohmann::json sliders = nlohmann::json::object();
+    for (const auto& [name, weight] : head.modifiers) sliders[name] = weight;
+    j["sliders"] = sliders;
+    j["slider_convention"] = "MakeHuman modifier weights in [0, 1] on the base head's modifier basis (MakeHuman's "
+                             "one-sided targets: 'nose/nose-trans-down' and 'nose/nose-trans-up' are the two ends of "
+                             "MakeHuman's slider 'nose/nose-trans-down|up'); the shared ones hold the right and left "
+                             "modifiers at one weight";
+    nlohmann::json makehuman = nlohmann::json::object();
+    for (const auto& [name, value] : makeHumanSliders(head.modifiers)) makehuman[name] = value;
+    j["makehuman_modifiers"] = makehuman;
+    j["makehuman_modifier_convention"] = "MakeHuman's two-sided sliders as a .mhm file writes them: upper end's weight "
+                                         "minus the lower end's, in [-1, 1]";
+    character["note"] = "target: the measured proportions exaggerated and clamped to the Narita slider ranges; "
+                        "achieved: what the character head (the base head with the sliders' modifiers) measures "
+                        "(front silhouette and feature vertices, the same mapping as the photo)";
+    character["skin"] = "MakeHuman toon01 tinted by the skin colour, with painted hair, brows, eyes and mouth";
     j["character_head"] = character;
 
     CharacterOutputs out;
     out.json = j.dump(2) + "\n";
     out.glb = encodeGlb(head.mesh, head.texture, "character");
     out.warnings = mapping.warnings;
+    out.warnings.insert(out.warnings.end(), head.warnings.begin(), head.warnings.end());
     out.head = std::move(head);
     out.makeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;

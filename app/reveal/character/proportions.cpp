@@ -157,8 +157,8 @@ nlohmann::json characterJson(const NaritaMapping& mapping, const CharacterPropor
                                        {"range", {s.lo, s.hi}},
                                        {"meaning", std::string(s.meaning)}};
     }
-    j["sliders"] = sliders;
-    j["slider_convention"] = "value = clamp((measured - range[0]) / (range[1] - range[0]), 0, 1)";
+    j["narita_sliders"] = sliders;
+    j["narita_slider_convention"] = "value = clamp((measured - range[0]) / (range[1] - range[0]), 0, 1)";
     j["warnings"] = mapping.warnings;
     return j;
 }

@@ -62,8 +62,9 @@ std::map<std::string, double> slidersOf(const CharacterProportions& p);
 // Every quantity clamped into its slider's range.
 CharacterProportions clampToSliderRanges(CharacterProportions p);
 
-// The character.json document: the method, each point (pixels) and where it came from, l_f0 and l_f1, r0..r7,
-// the extras, the sliders with their ranges, and the mapping's warnings.
+// The character.json document's measured part: the method, each point (pixels) and where it came from, l_f0 and
+// l_f1, r0..r7, the extras, Narita's sliders with their ranges ("narita_sliders"), and the mapping's warnings. The
+// model's own sliders (MakeHuman's modifiers, "sliders") are added by character_outputs.
 nlohmann::json characterJson(const NaritaMapping& mapping, const CharacterProportions& proportions);
 
 }  // namespace avatarbooth
