@@ -38,12 +38,14 @@ double objective(const std::vector<double>& N, const std::vector<double>& g, con
     return f;
 }
 
-// Minimises objective(N, g, x) over lo <= x <= hi from a feasible x (N symmetric positive definite). A variable at a
-// bound whose gradient pushes it outwards is held there; Newton's step for the others is projected onto the box and
-// halved until it decreases the objective enough (Armijo along the projection arc).
+// A variable at a bound whose gradient pushes it outwards is held there; Newton's step for the others is projected
+// onto the box and halved until it decreases the objective enough (Armijo along the projection arc).
+}  // namespace
+
 void minimiseInBox(const std::vector<double>& N, const std::vector<double>& g, const std::vector<double>& lo,
                    const std::vector<double>& hi, std::vector<double>& x, int maxSteps) {
     const std::size_t n = x.size();
+    for (std::size_t i = 0; i < n; ++i) x[i] = std::clamp(x[i], lo[i], hi[i]);
     double f = objective(N, g, x);
     std::vector<double> gradient(n), next(n);
     std::vector<std::size_t> free;
@@ -85,7 +87,6 @@ void minimiseInBox(const std::vector<double>& N, const std::vector<double>& g, c
     }
 }
 
-}  // namespace
 
 ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec3>& basePositions, const glm::dvec3& scale,
                          const glm::dvec3& centre, const std::vector<ModifierTarget>& targets,

@@ -61,4 +61,10 @@ ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec
                          const glm::dvec3& centre, const std::vector<ModifierTarget>& targets,
                          const ModifierFitOptions& options = {});
 
+// The solver underneath, for any small bounded quadratic problem (the character's sliders use it too): minimises
+// 1/2 x^T N x - g^T x over lo <= x <= hi (N dense, n x n row-major, symmetric positive definite; lo == hi holds a
+// variable), from x, which is moved into the box first; at most maxSteps projected Newton steps.
+void minimiseInBox(const std::vector<double>& N, const std::vector<double>& g, const std::vector<double>& lo,
+                   const std::vector<double>& hi, std::vector<double>& x, int maxSteps = 100);
+
 }  // namespace avatarbooth

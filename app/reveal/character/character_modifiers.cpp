@@ -1,6 +1,8 @@
 // The character's controls (MakeHuman modifiers per Narita quantity), their measured Jacobian and the bounded solve.
 #include "reveal/character/character_modifiers.h"
 
+#include "fit/head/modifier_fit.h"
+
 #include "reveal/character/character_head.h"
 #include "common/error.h"
 
@@ -177,32 +179,18 @@ std::vector<double> solveCharacterStep(const CharacterModel& model, const std::v
     }
     for (std::size_t a = 0; a < n; ++a)
         N[a * n + a] += regularisation * (a < model.firmness.size() ? model.firmness[a] : 1.0);
-    // Projected Gauss-Seidel within [0, 1]: a few dozen unknowns, the dense system is small. A slider's two ends
-    // (controls 2k and 2k + 1) are never both on, as on MakeHuman's own slider: where the solution has both, the
-    // weaker end is held at 0 and the rest solved again.
-    std::vector<double> w = weights;
-    std::vector<bool> held(n, false);
+    // Bounded to [0, 1] (fit/head/modifier_fit.h's solver). A slider's two ends (controls 2k and 2k + 1) are never
+    // both on, as on MakeHuman's own slider: where the solution has both, the weaker end is held at 0 and the rest
+    // solved again.
+    std::vector<double> w = weights, lower(n, 0.0), upper(n, 1.0);
     for (std::size_t c = 0; c + 1 < n; c += 2)
-        if (w[c] > 0.0 && w[c + 1] > 0.0) held[w[c] < w[c + 1] ? c : c + 1] = true;
+        if (w[c] > 0.0 && w[c + 1] > 0.0) upper[w[c] < w[c + 1] ? c : c + 1] = 0.0;
     for (int pass = 0; pass <= static_cast<int>(n); ++pass) {
-        for (std::size_t a = 0; a < n; ++a)
-            if (held[a]) w[a] = 0.0;
-        for (int sweep = 0; sweep < 2000; ++sweep) {
-            double change = 0.0;
-            for (std::size_t a = 0; a < n; ++a) {
-                if (held[a]) continue;
-                double s = g[a];
-                for (std::size_t b = 0; b < n; ++b) s -= N[a * n + b] * w[b];
-                const double next = std::clamp(w[a] + s / N[a * n + a], 0.0, 1.0);
-                change = std::max(change, std::abs(next - w[a]));
-                w[a] = next;
-            }
-            if (change < 1e-10) break;
-        }
+        minimiseInBox(N, g, lower, upper, w);
         bool clash = false;
         for (std::size_t c = 0; c + 1 < n; c += 2)
             if (w[c] > 0.0 && w[c + 1] > 0.0) {
-                held[w[c] < w[c + 1] ? c : c + 1] = true;
+                upper[w[c] < w[c + 1] ? c : c + 1] = 0.0;
                 clash = true;
             }
         if (!clash) break;
