@@ -1,6 +1,8 @@
 // The photo-to-head pipeline: steps, timings, which photo an error is about, cancellation between steps.
 #include "fit/fit_pipeline.h"
 
+#include "fit/parts/part_colours.h"
+
 #include "common/error.h"
 #include "common/image_io.h"
 #include "fit/face/profile.h"
@@ -184,6 +186,8 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture,
                                  *textureTables_);
     });
+    out.partColours = measurePartColours(front, out.frontLandmarks);
+    out.parts = placeParts(base_, out.fit.mesh, out.texture.texture, out.partColours);
     return out;
 }
 
