@@ -669,9 +669,36 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
             proxy.mesh.triangles.emplace_back(c[0], c[1], c[2]);  // counter-clockwise from outside, as hm08's
             if (c.size() == 4) proxy.mesh.triangles.emplace_back(c[0], c[2], c[3]);
         }
-        proxy.mesh.positions = placeProxy(proxy.binding, mesh.positions);
         proxy.texture = readImageWithAlpha(folder / file.textures.front());
-        return std::make_pair(proxy, file);
+        // Faces fully transparent in the texture (the eyes' cornea, a clear shell over the iris) are left out: the
+        // booth draws no glass.
+        cv::Mat alpha;
+        cv::extractChannel(proxy.texture, alpha, 3);
+        const auto clear = [&](std::uint32_t v) {
+            const glm::dvec2 uv = proxy.mesh.uvs[v];
+            const int x = std::clamp(static_cast<int>(uv.x * alpha.cols), 0, alpha.cols - 1);
+            const int y = std::clamp(static_cast<int>(uv.y * alpha.rows), 0, alpha.rows - 1);
+            return alpha.at<std::uint8_t>(y, x) == 0;
+        };
+        HeadProxy kept = proxy;
+        kept.mesh.triangles.clear();
+        kept.mesh.uvs.clear();
+        kept.binding = {};
+        std::map<std::uint32_t, std::uint32_t> keptIndex;
+        const auto keep = [&](std::uint32_t v) {
+            const auto [it, added] = keptIndex.emplace(v, static_cast<std::uint32_t>(kept.mesh.uvs.size()));
+            if (added) {
+                kept.mesh.uvs.push_back(proxy.mesh.uvs[v]);
+                kept.binding.vertices.push_back(proxy.binding.vertices[v]);
+                kept.binding.weights.push_back(proxy.binding.weights[v]);
+                kept.binding.offsets.push_back(proxy.binding.offsets[v]);
+            }
+            return it->second;
+        };
+        for (const auto& t : proxy.mesh.triangles)
+            if (!(clear(t.x) && clear(t.y) && clear(t.z))) kept.mesh.triangles.emplace_back(keep(t.x), keep(t.y), keep(t.z));
+        kept.mesh.positions = placeProxy(kept.binding, mesh.positions);
+        return std::make_pair(kept, file);
     };
     if (!options.eyes.empty()) {
         auto [eyes, file] = bindProxy("eyes", options.eyes, "eyes");
