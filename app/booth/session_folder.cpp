@@ -112,7 +112,7 @@ std::vector<fs::path> writeSessionFolder(const FitOutcome& o, const SessionFolde
     const auto t0 = Clock::now();
     put("avatar.glb", o.parts.empty() ? encodeGlb(o.fit.mesh, o.texture.texture, "avatar") : encodeGlb(o.parts));
     // The same avatar for iOS's AR Quick Look (the visitor's page offers both: booth/usdz.h).
-    put("avatar.usdz", encodeUsdz(o.fit.mesh, o.texture.texture));
+    put("avatar.usdz", o.parts.empty() ? encodeUsdz(o.fit.mesh, o.texture.texture) : encodeUsdz(o.parts));
     // The photos themselves, as taken (personal data: the files are readable by the booth's user only).
     photo("front", contents.photoFiles.front, o.front);
     photo("side", contents.photoFiles.side, o.side);

@@ -3,6 +3,7 @@
 // parts in a render and in a glb the Khronos validator accepts. Skips without the MakeHuman base head.
 #include "test_paths.h"
 
+#include "common/landmark_names.h"
 #include "fit/export/glb.h"
 #include "fit/head/base_head.h"
 #include "fit/head/makehuman_import.h"
@@ -319,6 +320,12 @@ TEST(AvatarParts, RenderedAndExported) {
         ++count;
     }
     std::printf("brows: %.1f grey levels darker than the bare skin at their vertices\n", darker / count);
+    {
+        double browY = 0.0, landmarkY = 0.0;
+        for (const auto& p : brows.mesh.positions) browY += p.y;
+        for (int k = 17; k <= 26; ++k) landmarkY += base.mesh.positions[base.frontFeatures.at(landmarkName(k))].y;
+        std::printf("brow proxy's mean height %.1f mm, brow landmarks' vertices %.1f mm\n", browY / static_cast<double>(brows.mesh.positions.size()), landmarkY / 10.0);
+    }
     EXPECT_GT(darker / count, 15.0);
 
     const std::string glb = encodeGlb(parts);

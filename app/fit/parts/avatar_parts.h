@@ -31,6 +31,13 @@ AvatarPart placeProxyPart(const HeadProxy& proxy, const Mesh& fittedHead, const 
 // (the iris' fibres, the strands' grain) and their mean becomes `bgr`; alpha and unmasked pixels are kept.
 cv::Mat tintTexture(const cv::Mat& texture, const cv::Mat& mask, const cv::Vec3d& bgr);
 
+// Moves a part up or down, each side of the face (x < 0, x > 0) on its own, so that its vertices within 4 mm (in x)
+// of each point lie `below` millimetres under it on average, each keeping its height over `head`'s front surface (the
+// surface seen from +z). The brows: the photo's own brows are on the texture where the fit put dlib's brow points,
+// and a brow proxy where MakeHuman's artist drew it would make a second brow beside them. `points` are head-space
+// (x, y). Sides with no point or no vertex near one stay.
+void alignToPoints(AvatarPart& part, const Mesh& head, const std::vector<glm::dvec2>& points, double below);
+
 // The mesh without the triangles that use any of `vertices`, its unused vertices dropped (UVs kept with them).
 Mesh withoutVertices(const Mesh& mesh, const std::vector<std::uint32_t>& vertices);
 

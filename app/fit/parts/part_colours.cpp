@@ -92,16 +92,18 @@ std::optional<cv::Vec3d> measureBrowColour(const cv::Mat& front, const FaceLandm
     cv::Mat mask(front.size(), CV_8U, cv::Scalar(0));
     for (const int first : {17, 22}) {
         std::vector<cv::Point> line;
+        // dlib puts the points on the brow's upper half: the band is centred a little below them.
         for (int k = first; k < first + 5; ++k)
-            line.emplace_back(cvRound(lm.points[static_cast<std::size_t>(k)].x), cvRound(lm.points[static_cast<std::size_t>(k)].y));
+            line.emplace_back(cvRound(lm.points[static_cast<std::size_t>(k)].x),
+                              cvRound(lm.points[static_cast<std::size_t>(k)].y + 0.3 * thickness));
         for (const auto& p : line)
             if (!cv::Rect(0, 0, front.cols, front.rows).contains(p)) return std::nullopt;
         cv::polylines(mask, std::vector<std::vector<cv::Point>>{line}, false, cv::Scalar(255), cvRound(thickness), cv::LINE_8);
     }
     const std::vector<Pixel> pixels = pixelsUnder(front, mask, cv::Rect(0, 0, front.cols, front.rows));
     if (pixels.size() < 20) return std::nullopt;
-    // The darkest third: the hairs, not the skin between and around them.
-    return medianColour(std::vector<Pixel>(pixels.begin(), pixels.begin() + static_cast<std::ptrdiff_t>(pixels.size() / 3)));
+    // The darkest quarter: the hairs, not the skin between and around them.
+    return medianColour(std::vector<Pixel>(pixels.begin(), pixels.begin() + static_cast<std::ptrdiff_t>(pixels.size() / 4)));
 }
 
 PartColours measurePartColours(const cv::Mat& front, const FaceLandmarks& landmarks) {

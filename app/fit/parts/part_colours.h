@@ -16,8 +16,8 @@ namespace avatarbooth {
 // brightest); the median of both eyes' such pixels. Nothing when the eyes are too small or closed in the photo.
 std::optional<cv::Vec3d> measureIrisColour(const cv::Mat& frontBgr, const FaceLandmarks& landmarks);
 
-// The brows' colour (BGR): along the brow landmarks (17-21, 22-26) in a band as thick as a brow, the darker half of
-// the pixels (the hairs, not the skin between them), their median. Nothing when the band leaves the photo.
+// The brows' colour (BGR): along the brow landmarks (17-21, 22-26) in a band as thick as a brow, the darkest quarter
+// of the pixels (the hairs, not the skin between them), their median. Nothing when the band leaves the photo.
 std::optional<cv::Vec3d> measureBrowColour(const cv::Mat& frontBgr, const FaceLandmarks& landmarks);
 
 // Both, keyed by the part they colour ("eyes", "eyebrows").
