@@ -149,10 +149,12 @@ HeadProxy loadHeadProxy(const fs::path& file, const std::vector<glm::dvec3>& hea
                 throw BoothError(ErrorKind::BadConfig, where, "field 'replaces' refers past the base head's vertices");
             p.replaces.push_back(v.get<std::uint32_t>());
         }
-        p.texture = readImageWithAlpha(file.parent_path() / field("texture").get<std::string>());
+        PhotoLimits textureLimits;
+        textureLimits.minSide = 1;  // a texture may be small; the photos' lower limit is for faces
+        p.texture = readImageWithAlpha(file.parent_path() / field("texture").get<std::string>(), textureLimits);
         if (p.alpha == AlphaMode::Opaque) cv::cvtColor(p.texture, p.texture, cv::COLOR_BGRA2BGR);
         if (j.contains("tint_mask")) {
-            cv::Mat mask = readPhoto(file.parent_path() / j["tint_mask"].get<std::string>());
+            cv::Mat mask = readPhoto(file.parent_path() / j["tint_mask"].get<std::string>(), textureLimits);
             cv::extractChannel(mask, p.tintMask, 0);
             if (p.tintMask.size() != p.texture.size())
                 throw BoothError(ErrorKind::BadConfig, where, "its tint mask and texture differ in size");
