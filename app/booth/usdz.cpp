@@ -77,7 +77,8 @@ void appendMesh(std::string& u, const std::string& prim, const Mesh& mesh, bool 
     mesh.bounds(lo, hi);
     const auto metres = [](double mm) { return static_cast<float>(mm * kMetresPerMm); };
     u += "    def Mesh \"" + prim + "\" (\n        prepend apiSchemas = [\"MaterialBindingAPI\"]\n    )\n    {\n";
-    u += std::string("        uniform bool doubleSided = ") + (doubleSided ? "1" : "0") + "\n";
+    u += "        uniform bool doubleSided = ";
+    u += doubleSided ? "1\n" : "0\n";
     u += "        float3[] extent = [";
     appendTuple(u, {metres(lo.x), metres(lo.y), metres(lo.z)});
     u += ", ";

@@ -34,5 +34,7 @@ cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int 
 // head neither grows nor shrinks as it turns): lit, square (size x size, BGR), on the previews' grey. The same
 // checks as renderPreviews.
 std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames);
+// The same of the avatar's parts (all uploaded with MeshRenderer::upload(parts)), at the scale of them all.
+std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames);
 
 }  // namespace avatarbooth

@@ -289,11 +289,11 @@ TEST(AvatarParts, RenderedAndExported) {
     // 3.4-5 mm around it.
     for (const double side : {-1.0, 1.0}) {
         const AvatarPart& eyes = parts[1];
-        glm::dvec3 centre(0.0);
+        glm::dvec3 eyeCentre(0.0);
         int n = 0;
         for (const auto& p : eyes.mesh.positions)
-            if (p.x * side > 0) centre += p, ++n;
-        const glm::dvec3 apex = centre / static_cast<double>(n);
+            if (p.x * side > 0) eyeCentre += p, ++n;
+        const glm::dvec3 apex = eyeCentre / static_cast<double>(n);
         const glm::dvec2 px = camera.project(apex);
         int greenish = 0, total = 0, greenishHead = 0;
         for (double r = 3.4; r <= 5.0; r += 0.4)

@@ -207,6 +207,8 @@ const T* accessorData(const tinygltf::Model& model, int accessorIndex, int expec
     return reinterpret_cast<const T*>(buffer.data.data() + offset);
 }
 
+Mesh primitiveMesh(const tinygltf::Model& model, const tinygltf::Primitive& primitive, const std::string& where);
+
 }  // namespace
 
 Mesh readGlbMesh(const std::filesystem::path& path) {
@@ -214,7 +216,58 @@ Mesh readGlbMesh(const std::filesystem::path& path) {
     const tinygltf::Model model = loadModel(path);
     if (model.meshes.empty() || model.meshes[0].primitives.empty())
         throw BoothError(ErrorKind::BadConfig, where, "holds no mesh");
-    const auto& primitive = model.meshes[0].primitives[0];
+    return primitiveMesh(model, model.meshes[0].primitives[0], where);
+}
+
+namespace {
+
+// The base colour texture of a material as BGR(A), or an empty Mat.
+cv::Mat materialTexture(const tinygltf::Model& model, int materialIndex, bool withAlpha) {
+    if (materialIndex < 0 || materialIndex >= static_cast<int>(model.materials.size())) return {};
+    const int texIndex = model.materials[static_cast<std::size_t>(materialIndex)].pbrMetallicRoughness.baseColorTexture.index;
+    if (texIndex < 0 || texIndex >= static_cast<int>(model.textures.size())) return {};
+    const int source = model.textures[static_cast<std::size_t>(texIndex)].source;
+    if (source < 0 || source >= static_cast<int>(model.images.size())) return {};
+    const auto& image = model.images[static_cast<std::size_t>(source)];
+    // tinygltf decodes embedded images to RGBA(8) pixels.
+    if (image.image.empty() || image.bits != 8 || (image.component != 3 && image.component != 4)) return {};
+    cv::Mat pixels(image.height, image.width, image.component == 4 ? CV_8UC4 : CV_8UC3,
+                   const_cast<unsigned char*>(image.image.data()));
+    cv::Mat out;
+    if (withAlpha) cv::cvtColor(pixels, out, image.component == 4 ? cv::COLOR_RGBA2BGRA : cv::COLOR_RGB2BGRA);
+    else cv::cvtColor(pixels, out, image.component == 4 ? cv::COLOR_RGBA2BGR : cv::COLOR_RGB2BGR);
+    return out;
+}
+
+}  // namespace
+
+std::vector<AvatarPart> readGlbParts(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    const tinygltf::Model model = loadModel(path);
+    std::vector<AvatarPart> parts;
+    for (const auto& node : model.nodes) {
+        if (node.mesh < 0 || node.mesh >= static_cast<int>(model.meshes.size())) continue;
+        const auto& mesh = model.meshes[static_cast<std::size_t>(node.mesh)];
+        if (mesh.primitives.empty()) continue;
+        AvatarPart part;
+        part.name = node.name;
+        part.mesh = primitiveMesh(model, mesh.primitives[0], where);
+        const int material = mesh.primitives[0].material;
+        if (material >= 0 && material < static_cast<int>(model.materials.size())) {
+            const auto& m = model.materials[static_cast<std::size_t>(material)];
+            part.alpha = m.alphaMode == "MASK" ? AlphaMode::Mask : m.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+            part.alphaCutoff = m.alphaCutoff;
+        }
+        part.texture = materialTexture(model, material, part.alpha != AlphaMode::Opaque);
+        parts.push_back(std::move(part));
+    }
+    if (parts.empty()) throw BoothError(ErrorKind::BadConfig, where, "holds no mesh");
+    return parts;
+}
+
+namespace {
+
+Mesh primitiveMesh(const tinygltf::Model& model, const tinygltf::Primitive& primitive, const std::string& where) {
     if (primitive.mode != TINYGLTF_MODE_TRIANGLES && primitive.mode != -1)
         throw BoothError(ErrorKind::BadConfig, where, "first primitive is not made of triangles");
     Mesh mesh;
@@ -255,6 +308,8 @@ Mesh readGlbMesh(const std::filesystem::path& path) {
     }
     return mesh;
 }
+
+}  // namespace
 
 cv::Mat readGlbTexture(const std::filesystem::path& path) {
     const tinygltf::Model model = loadModel(path);

@@ -30,6 +30,10 @@ void writeGlb(const std::filesystem::path& path, const Mesh& mesh, const cv::Mat
 // Throws BoothError(BadConfig) naming the file and what is missing.
 Mesh readGlbMesh(const std::filesystem::path& path);
 
+// Reads every node's mesh (its first primitive) as a part: the node's name, the material's alpha mode and cutoff, its
+// base colour texture (BGRA for MASK and BLEND, BGR otherwise; empty when there is none). Throws like readGlbMesh.
+std::vector<AvatarPart> readGlbParts(const std::filesystem::path& path);
+
 // Reads the base colour texture of the first material, or an empty Mat.
 cv::Mat readGlbTexture(const std::filesystem::path& path);
 

@@ -676,29 +676,29 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
         cv::extractChannel(proxy.texture, alpha, 3);
         const auto clear = [&](std::uint32_t v) {
             const glm::dvec2 uv = proxy.mesh.uvs[v];
-            const int x = std::clamp(static_cast<int>(uv.x * alpha.cols), 0, alpha.cols - 1);
-            const int y = std::clamp(static_cast<int>(uv.y * alpha.rows), 0, alpha.rows - 1);
-            return alpha.at<std::uint8_t>(y, x) == 0;
+            const int column = std::clamp(static_cast<int>(uv.x * alpha.cols), 0, alpha.cols - 1);
+            const int row = std::clamp(static_cast<int>(uv.y * alpha.rows), 0, alpha.rows - 1);
+            return alpha.at<std::uint8_t>(row, column) == 0;
         };
-        HeadProxy kept = proxy;
-        kept.mesh.triangles.clear();
-        kept.mesh.uvs.clear();
-        kept.binding = {};
+        HeadProxy visible = proxy;
+        visible.mesh.triangles.clear();
+        visible.mesh.uvs.clear();
+        visible.binding = {};
         std::map<std::uint32_t, std::uint32_t> keptIndex;
         const auto keep = [&](std::uint32_t v) {
-            const auto [it, added] = keptIndex.emplace(v, static_cast<std::uint32_t>(kept.mesh.uvs.size()));
+            const auto [it, added] = keptIndex.emplace(v, static_cast<std::uint32_t>(visible.mesh.uvs.size()));
             if (added) {
-                kept.mesh.uvs.push_back(proxy.mesh.uvs[v]);
-                kept.binding.vertices.push_back(proxy.binding.vertices[v]);
-                kept.binding.weights.push_back(proxy.binding.weights[v]);
-                kept.binding.offsets.push_back(proxy.binding.offsets[v]);
+                visible.mesh.uvs.push_back(proxy.mesh.uvs[v]);
+                visible.binding.vertices.push_back(proxy.binding.vertices[v]);
+                visible.binding.weights.push_back(proxy.binding.weights[v]);
+                visible.binding.offsets.push_back(proxy.binding.offsets[v]);
             }
             return it->second;
         };
         for (const auto& t : proxy.mesh.triangles)
-            if (!(clear(t.x) && clear(t.y) && clear(t.z))) kept.mesh.triangles.emplace_back(keep(t.x), keep(t.y), keep(t.z));
-        kept.mesh.positions = placeProxy(kept.binding, mesh.positions);
-        return std::make_pair(kept, file);
+            if (!(clear(t.x) && clear(t.y) && clear(t.z))) visible.mesh.triangles.emplace_back(keep(t.x), keep(t.y), keep(t.z));
+        visible.mesh.positions = placeProxy(visible.binding, mesh.positions);
+        return std::make_pair(visible, file);
     };
     if (!options.eyes.empty()) {
         auto [eyes, file] = bindProxy("eyes", options.eyes, "eyes");
