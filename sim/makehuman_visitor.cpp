@@ -202,6 +202,8 @@ std::pair<MakeHumanPerson, Look> draw(const ModifierBasis& basis, unsigned seed)
     const Colour& iris = pickColour(rng, irisColours(), ethnicity);
     look.iris = iris.bgr;
     p.eyes = iris.name;
+    p.irisBgr = look.iris;
+    p.browBgr = look.brow;
     return {std::move(p), look};
 }
 

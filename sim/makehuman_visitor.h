@@ -43,6 +43,7 @@ struct MakeHumanPerson {
     std::string skin;       // the MakeHuman skin: AGE_ETHNICITY_SEX
     std::string hair;       // its colour, or "bald"
     std::string eyes;       // the iris colour
+    cv::Vec3d irisBgr{0, 0, 0}, browBgr{0, 0, 0};  // the colours painted (0..255, before the photos' shading)
     std::vector<double> weights;  // one per modifier of the base head's basis, in [0, 1]
 };
 

@@ -21,14 +21,13 @@ TurntableEnded makeTurntable(const std::filesystem::path& keptFolder, const Turn
     TurntableEnded done{keptFolder, 0, 0.0, 0.0, std::nullopt};
     const auto t0 = std::chrono::steady_clock::now();
     const std::filesystem::path glb = keptFolder / "avatar.glb";
-    const Mesh mesh = readGlbMesh(glb);
-    const cv::Mat texture = readGlbTexture(glb);
+    const std::vector<AvatarPart> parts = readGlbParts(glb);  // the head, then eyes, brows, lashes, ...
     std::vector<cv::Mat> frames;
     {
         // A renderer of its own for the job (as the session writer's): its GL context and buffers go with it.
         MeshRenderer renderer(MeshRendererOptions{.maxSamples = 2, .depth = false});
-        renderer.upload(mesh, texture);
-        frames = renderTurntable(renderer, mesh, spec.size, spec.frames);
+        renderer.upload(parts);
+        frames = renderTurntable(renderer, parts, spec.size, spec.frames);
     }
     done.renderSeconds = since(t0);
     const auto t1 = std::chrono::steady_clock::now();

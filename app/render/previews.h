@@ -22,6 +22,9 @@ struct PreviewSet {
 // the uploaded one.
 PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size = 512);
 
+// The same of the avatar's parts (all uploaded to `renderer` with MeshRenderer::upload(parts)), framed to them all.
+PreviewSet renderPreviews(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size = 512);
+
 // The three-quarter view alone (the same picture as PreviewSet::threeQuarter), for a second mesh such as the
 // character: the same checks.
 cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size = 512);
@@ -31,5 +34,7 @@ cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int 
 // head neither grows nor shrinks as it turns): lit, square (size x size, BGR), on the previews' grey. The same
 // checks as renderPreviews.
 std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames);
+// The same of the avatar's parts (all uploaded with MeshRenderer::upload(parts)), at the scale of them all.
+std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames);
 
 }  // namespace avatarbooth

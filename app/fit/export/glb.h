@@ -2,11 +2,13 @@
 #pragma once
 
 #include "fit/head/mesh.h"
+#include "fit/parts/avatar_part.h"
 
 #include <opencv2/core.hpp>
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace avatarbooth {
 
@@ -15,6 +17,11 @@ namespace avatarbooth {
 // millimetre positions are scaled by 1/1000. An empty texture gives an untextured skin-coloured material.
 std::string encodeGlb(const Mesh& mesh, const cv::Mat& texture, const std::string& name = "avatar");
 
+// The avatar's parts (avatar_part.h) in one glb: per part one mesh (one primitive as above), one node named after
+// it and one material with the part's alpha mode (MASK with its cutoff; MASK and BLEND double-sided, their textures
+// PNG with alpha), all nodes in the one scene, in the parts' order.
+std::string encodeGlb(const std::vector<AvatarPart>& parts);
+
 // Writes encodeGlb(...) to path atomically.
 void writeGlb(const std::filesystem::path& path, const Mesh& mesh, const cv::Mat& texture,
               const std::string& name = "avatar");
@@ -22,6 +29,10 @@ void writeGlb(const std::filesystem::path& path, const Mesh& mesh, const cv::Mat
 // Reads the first triangle primitive of a glb (positions in metres -> millimetres, TEXCOORD_0, indices).
 // Throws BoothError(BadConfig) naming the file and what is missing.
 Mesh readGlbMesh(const std::filesystem::path& path);
+
+// Reads every node's mesh (its first primitive) as a part: the node's name, the material's alpha mode and cutoff, its
+// base colour texture (BGRA for MASK and BLEND, BGR otherwise; empty when there is none). Throws like readGlbMesh.
+std::vector<AvatarPart> readGlbParts(const std::filesystem::path& path);
 
 // Reads the base colour texture of the first material, or an empty Mat.
 cv::Mat readGlbTexture(const std::filesystem::path& path);
