@@ -41,6 +41,11 @@ struct MakeHumanPerson {
     std::string ethnicity;  // "african", "asian", "caucasian" (the largest share; the others may be mixed in)
     std::string skin;       // the MakeHuman skin: AGE_ETHNICITY_SEX
     std::string hair;       // its colour, or "bald"
+    // The hair as the photos show it (fit/face/hair_analysis.h's styles): "none" (bald, or balding: a horseshoe),
+    // or the style drawn; "short" is a painted cap of hair on the scalp.
+    std::string hairStyle;
+    cv::Vec3d hairColour{0.0, 0.0, 0.0};  // BGR, the painted hair's colour (before shading), when there is hair
+    std::string beard;      // "none", "moustache" or "full" (chin, jaw and upper lip)
     std::string eyes;       // the iris colour
     std::vector<double> weights;  // one per modifier of the base head's basis, in [0, 1]
 };

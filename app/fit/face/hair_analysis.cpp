@@ -224,6 +224,7 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out) {
         a.hair = true;
         a.hairLab = {median(hairLab[0]), median(hairLab[1]), median(hairLab[2])};
         out.hairLab = a.hairLab;
+        out.evidence.hairFromSkin = labDistance(cv::Vec3f(a.hairLab), a.skinLab);
         out.colour = {median(hairBgr[0]), median(hairBgr[1]), median(hairBgr[2])};
     }
 

@@ -34,6 +34,9 @@ std::optional<HairStyle> hairStyleFromString(std::string_view name);
 // What the estimate was read from: the share of hair-coloured pixels in each window (0..1), for fit.json and tests.
 struct HairEvidence {
     double crown = 0.0;            // front: a band 20 mm deep under the head's top, over the face's width
+    // The crown's unlike-skin pixels' median against the skin's (labDistance units). Not used: a bald scalp in the
+    // top light (15-30) and blond or light brown hair on pale skin (14-26) overlap on the synthetic people.
+    double hairFromSkin = 0.0;
     double besideFace = 0.0;       // front: beside the jaw, from the nose's base to the lower lip
     double belowChin = 0.0;        // front: beside the neck, 10-45 mm under the chin
     double behindHead = 0.0;       // side: behind the ear, from 10 to 50 mm under the ear hole
