@@ -204,6 +204,8 @@ std::pair<MakeHumanPerson, Look> draw(const ModifierBasis& basis, unsigned seed)
     const Colour& iris = pickColour(rng, irisColours(), ethnicity);
     look.iris = iris.bgr;
     p.eyes = iris.name;
+    p.irisBgr = look.iris;
+    p.browBgr = look.brow;
 
     // --- Issue 22's hair and beard, from a generator of their own, so that the people drawn before stay the same.
     Rng hairRng(seed * 40503u + 977u);

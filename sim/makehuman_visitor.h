@@ -47,6 +47,7 @@ struct MakeHumanPerson {
     cv::Vec3d hairColour{0.0, 0.0, 0.0};  // BGR, the painted hair's colour (before shading), when there is hair
     std::string beard;      // "none", "moustache" or "full" (chin, jaw and upper lip)
     std::string eyes;       // the iris colour
+    cv::Vec3d irisBgr{0, 0, 0}, browBgr{0, 0, 0};  // the colours painted (0..255, before the photos' shading)
     std::vector<double> weights;  // one per modifier of the base head's basis, in [0, 1]
 };
 

@@ -110,9 +110,9 @@ std::vector<fs::path> writeSessionFolder(const FitOutcome& o, const SessionFolde
         put(name + photoExtension(file), file.empty() ? encodeImage(image, ".jpg") : readFileBytes(file));
     };
     const auto t0 = Clock::now();
-    put("avatar.glb", encodeGlb(o.fit.mesh, o.texture.texture, "avatar"));
+    put("avatar.glb", o.parts.empty() ? encodeGlb(o.fit.mesh, o.texture.texture, "avatar") : encodeGlb(o.parts));
     // The same avatar for iOS's AR Quick Look (the visitor's page offers both: booth/usdz.h).
-    put("avatar.usdz", encodeUsdz(o.fit.mesh, o.texture.texture));
+    put("avatar.usdz", o.parts.empty() ? encodeUsdz(o.fit.mesh, o.texture.texture) : encodeUsdz(o.parts));
     // The photos themselves, as taken (personal data: the files are readable by the booth's user only).
     photo("front", contents.photoFiles.front, o.front);
     photo("side", contents.photoFiles.side, o.side);
@@ -121,8 +121,14 @@ std::vector<fs::path> writeSessionFolder(const FitOutcome& o, const SessionFolde
     const double exportSeconds = secondsSince(t0);
 
     const auto t1 = Clock::now();
-    renderer.upload(o.fit.mesh, o.texture.texture);
-    const PreviewSet previews = renderPreviews(renderer, o.fit.mesh, contents.previewSize);
+    PreviewSet previews;
+    if (o.parts.empty()) {
+        renderer.upload(o.fit.mesh, o.texture.texture);
+        previews = renderPreviews(renderer, o.fit.mesh, contents.previewSize);
+    } else {
+        renderer.upload(o.parts);
+        previews = renderPreviews(renderer, o.parts, contents.previewSize);
+    }
     put("preview_front.png", encodeImage(previews.front, ".png"));
     put("preview_side.png", encodeImage(previews.side, ".png"));
     put("preview_three_quarter.png", encodeImage(previews.threeQuarter, ".png"));

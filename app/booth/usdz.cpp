@@ -6,6 +6,7 @@
 
 #include <zlib.h>
 
+#include <cctype>
 #include <charconv>
 #include <cstdint>
 #include <limits>
@@ -64,22 +65,19 @@ void put32(std::string& out, std::uint32_t v) {
 
 }  // namespace
 
-std::string encodeUsda(const Mesh& mesh, const std::string& textureFile) {
+namespace {
+
+// One part's Mesh prim, bound to the material at `material`.
+void appendMesh(std::string& u, const std::string& prim, const Mesh& mesh, bool textured, bool doubleSided,
+                const std::string& material) {
     if (mesh.positions.empty() || mesh.triangles.empty())
         throw BoothError(ErrorKind::Internal, "", "cannot export an empty mesh");
     const std::size_t n = mesh.positions.size();
-    const bool textured = !textureFile.empty() && mesh.uvs.size() == n;
     glm::dvec3 lo, hi;
     mesh.bounds(lo, hi);
     const auto metres = [](double mm) { return static_cast<float>(mm * kMetresPerMm); };
-
-    std::string u;
-    u.reserve(n * 120 + mesh.triangles.size() * 30 + 4096);
-    u += "#usda 1.0\n(\n    defaultPrim = \"avatar\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n"
-         "    doc = \"avatarbooth " AVATARBOOTH_VERSION "\"\n)\n\n";
-    u += "def Xform \"avatar\" (\n    kind = \"component\"\n)\n{\n";
-    u += "    def Mesh \"head\" (\n        prepend apiSchemas = [\"MaterialBindingAPI\"]\n    )\n    {\n";
-    u += "        uniform bool doubleSided = 0\n";
+    u += "    def Mesh \"" + prim + "\" (\n        prepend apiSchemas = [\"MaterialBindingAPI\"]\n    )\n    {\n";
+    u += std::string("        uniform bool doubleSided = ") + (doubleSided ? "1" : "0") + "\n";
     u += "        float3[] extent = [";
     appendTuple(u, {metres(lo.x), metres(lo.y), metres(lo.z)});
     u += ", ";
@@ -90,7 +88,7 @@ std::string encodeUsda(const Mesh& mesh, const std::string& textureFile) {
         const auto& t = mesh.triangles[i];
         o += std::to_string(t.x) + ", " + std::to_string(t.y) + ", " + std::to_string(t.z);
     });
-    u += "        rel material:binding = </avatar/Materials/skin>\n";
+    u += "        rel material:binding = <" + material + ">\n";
     const std::vector<glm::dvec3> normals = mesh.vertexNormals();
     appendArray(u, "normal3f[] normals", n, [&](std::string& o, std::size_t i) {
         appendTuple(o, {static_cast<float>(normals[i].x), static_cast<float>(normals[i].y), static_cast<float>(normals[i].z)});
@@ -104,14 +102,26 @@ std::string encodeUsda(const Mesh& mesh, const std::string& textureFile) {
             appendTuple(o, {static_cast<float>(mesh.uvs[i].x), static_cast<float>(1.0 - mesh.uvs[i].y)});
         }, " (\n            interpolation = \"vertex\"\n        )");
     u += "        uniform token subdivisionScheme = \"none\"\n    }\n\n";
+}
 
-    const std::string material = "/avatar/Materials/skin";
-    u += "    def Scope \"Materials\"\n    {\n        def Material \"skin\"\n        {\n";
+// One UsdPreviewSurface material; its opacity from the texture's alpha for masked and blended parts.
+void appendMaterial(std::string& u, const std::string& name, const std::string& textureFile, AlphaMode alpha,
+                    double alphaCutoff) {
+    const std::string material = "/avatar/Materials/" + name;
+    const bool textured = !textureFile.empty();
+    const bool withAlpha = textured && alpha != AlphaMode::Opaque;
+    u += "        def Material \"" + name + "\"\n        {\n";
     u += "            token outputs:surface.connect = <" + material + "/surface.outputs:surface>\n\n";
     u += "            def Shader \"surface\"\n            {\n";
     u += "                uniform token info:id = \"UsdPreviewSurface\"\n";
     if (textured) u += "                color3f inputs:diffuseColor.connect = <" + material + "/texture.outputs:rgb>\n";
     else u += "                color3f inputs:diffuseColor = (0.8, 0.62, 0.52)\n";
+    if (withAlpha) u += "                float inputs:opacity.connect = <" + material + "/texture.outputs:a>\n";
+    if (withAlpha && alpha == AlphaMode::Mask) {
+        u += "                float inputs:opacityThreshold = ";
+        appendFloat(u, static_cast<float>(alphaCutoff));
+        u += "\n";
+    }
     u += "                float inputs:metallic = 0\n                float inputs:roughness = 0.8\n";
     u += "                token outputs:surface\n            }\n";
     if (textured) {
@@ -123,10 +133,56 @@ std::string encodeUsda(const Mesh& mesh, const std::string& textureFile) {
         u += "                asset inputs:file = @" + textureFile + "@\n";
         u += "                float2 inputs:st.connect = <" + material + "/st_reader.outputs:result>\n";
         u += "                token inputs:wrapS = \"clamp\"\n                token inputs:wrapT = \"clamp\"\n";
-        u += "                float3 outputs:rgb\n            }\n";
+        u += "                float3 outputs:rgb\n";
+        if (withAlpha) u += "                float outputs:a\n";
+        u += "            }\n";
     }
-    u += "        }\n    }\n}\n";
+    u += "        }\n";
+}
+
+// The layer of parts given as (prim name, material name, part, texture file or empty).
+struct LayerPart {
+    std::string prim, material;
+    const AvatarPart* part;
+    std::string textureFile;
+};
+
+std::string encodeLayer(const std::vector<LayerPart>& parts) {
+    std::size_t size = 4096;
+    for (const auto& p : parts) size += p.part->mesh.positions.size() * 120 + p.part->mesh.triangles.size() * 30;
+    std::string u;
+    u.reserve(size);
+    u += "#usda 1.0\n(\n    defaultPrim = \"avatar\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n"
+         "    doc = \"avatarbooth " AVATARBOOTH_VERSION "\"\n)\n\n";
+    u += "def Xform \"avatar\" (\n    kind = \"component\"\n)\n{\n";
+    for (const auto& p : parts)
+        appendMesh(u, p.prim, p.part->mesh, !p.textureFile.empty() && p.part->mesh.uvs.size() == p.part->mesh.positions.size(),
+                   p.part->alpha != AlphaMode::Opaque, "/avatar/Materials/" + p.material);
+    u += "    def Scope \"Materials\"\n    {\n";
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        if (i) u += "\n";
+        const auto& p = parts[i];
+        const bool textured = !p.textureFile.empty() && p.part->mesh.uvs.size() == p.part->mesh.positions.size();
+        appendMaterial(u, p.material, textured ? p.textureFile : "", p.part->alpha, p.part->alphaCutoff);
+    }
+    u += "    }\n}\n";
     return u;
+}
+
+// USD prim names are identifiers: letters, digits and underscores, not starting with a digit.
+std::string primName(const std::string& name) {
+    std::string out;
+    for (const char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+    if (out.empty() || std::isdigit(static_cast<unsigned char>(out[0]))) out = "part_" + out;
+    return out;
+}
+
+}  // namespace
+
+std::string encodeUsda(const Mesh& mesh, const std::string& textureFile) {
+    AvatarPart part;
+    part.mesh = mesh;
+    return encodeLayer({{"head", "skin", &part, textureFile}});
 }
 
 std::string storeAlignedZip(const std::vector<std::pair<std::string, std::string_view>>& files) {
@@ -192,13 +248,39 @@ std::string storeAlignedZip(const std::vector<std::pair<std::string, std::string
 }
 
 std::string encodeUsdz(const Mesh& mesh, const cv::Mat& texture) {
-    const bool textured = !texture.empty() && mesh.uvs.size() == mesh.positions.size();
-    const std::string textureName = textured ? "texture.jpg" : "";
-    const std::string layer = encodeUsda(mesh, textureName);
-    // The glb's texture quality (fit/export/glb.cpp), so both AR files look the same.
-    const std::string jpeg = textured ? encodeImage(texture, ".jpg", 92) : std::string();
-    std::vector<std::pair<std::string, std::string_view>> files{{"avatar.usda", layer}};
-    if (textured) files.emplace_back(textureName, jpeg);
+    AvatarPart part;
+    part.name = "head";
+    part.mesh = mesh;
+    part.texture = texture;
+    return encodeUsdz(std::vector<AvatarPart>{std::move(part)});
+}
+
+std::string encodeUsdz(const std::vector<AvatarPart>& parts) {
+    if (parts.empty()) throw BoothError(ErrorKind::Internal, "", "cannot export an avatar without parts");
+    // The first part is the head, its material "skin" and its texture "texture.jpg" (as the single-mesh layer);
+    // every other part is named after itself, its texture a PNG where its alpha counts.
+    std::vector<LayerPart> layer;
+    std::vector<std::string> images;
+    images.reserve(parts.size());
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        const AvatarPart& part = parts[i];
+        const bool textured = !part.texture.empty() && part.mesh.uvs.size() == part.mesh.positions.size();
+        const bool withAlpha = part.alpha != AlphaMode::Opaque && part.texture.channels() == 4;
+        const std::string name = i == 0 ? "head" : primName(part.name);
+        std::string file;
+        if (textured) {
+            file = i == 0 ? "texture.jpg" : name + (withAlpha ? ".png" : ".jpg");
+            // The glb's texture quality (fit/export/glb.cpp), so both AR files look the same.
+            images.push_back(withAlpha ? encodeImage(part.texture, ".png") : encodeImage(part.texture, ".jpg", 92));
+        } else {
+            images.emplace_back();
+        }
+        layer.push_back({name, i == 0 ? "skin" : name, &part, file});
+    }
+    const std::string usda = encodeLayer(layer);
+    std::vector<std::pair<std::string, std::string_view>> files{{"avatar.usda", usda}};
+    for (std::size_t i = 0; i < layer.size(); ++i)
+        if (!layer[i].textureFile.empty()) files.emplace_back(layer[i].textureFile, images[i]);
     return storeAlignedZip(files);
 }
 

@@ -12,6 +12,7 @@
 #pragma once
 
 #include "fit/head/mesh.h"
+#include "fit/parts/avatar_part.h"
 
 #include <opencv2/core.hpp>
 
@@ -28,6 +29,12 @@ std::string encodeUsda(const Mesh& mesh, const std::string& textureFile);
 
 // The .usdz bytes: the layer and `texture` (BGR, as a JPEG). Throws BoothError(Internal) for an empty mesh.
 std::string encodeUsdz(const Mesh& mesh, const cv::Mat& texture);
+
+// The avatar's parts (fit/parts/avatar_part.h) in one archive: the first part as the head above (Mesh "head",
+// material "skin", texture.jpg), each other one a Mesh and a Material named after it with its texture NAME.jpg, or
+// NAME.png when its alpha counts: then the material's opacity is the texture's alpha (with opacityThreshold for
+// MASK) and the mesh is double-sided.
+std::string encodeUsdz(const std::vector<AvatarPart>& parts);
 
 // The zip part alone: `files` (name, bytes) stored in order, each one's data 64-byte aligned (padding in the
 // local header's extra field, id 0x1986 as Pixar's writer uses). Names must be plain ASCII.

@@ -192,6 +192,7 @@ struct PngDecode {
     png_infop info = nullptr;
     cv::Mat image;
     std::vector<png_bytep> rows;
+    bool alpha = false;  // BGRA out: the file's alpha (or tRNS), opaque where it has none
 };
 
 bool runPngDecode(PngDecode* d) {
@@ -206,14 +207,20 @@ bool runPngDecode(PngDecode* d) {
     if (depth == 16) png_set_strip_16(d->png);
     if (colour == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(d->png);
     if (colour == PNG_COLOR_TYPE_GRAY && depth < 8) png_set_expand_gray_1_2_4_to_8(d->png);
-    if (colour & PNG_COLOR_MASK_ALPHA) png_set_strip_alpha(d->png);
+    if (d->alpha) {
+        if (png_get_valid(d->png, d->info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(d->png);
+        else if (!(colour & PNG_COLOR_MASK_ALPHA)) png_set_add_alpha(d->png, 0xFF, PNG_FILLER_AFTER);
+    } else if (colour & PNG_COLOR_MASK_ALPHA) {
+        png_set_strip_alpha(d->png);
+    }
     if (colour == PNG_COLOR_TYPE_GRAY || colour == PNG_COLOR_TYPE_GRAY_ALPHA) png_set_gray_to_rgb(d->png);
     png_set_bgr(d->png);
     png_set_interlace_handling(d->png);
     png_read_update_info(d->png, d->info);
-    if (png_get_rowbytes(d->png, d->info) != static_cast<png_size_t>(width) * 3)
+    const int channels = d->alpha ? 4 : 3;
+    if (png_get_rowbytes(d->png, d->info) != static_cast<png_size_t>(width) * channels)
         png_error(d->png, "an unexpected pixel layout");
-    d->image.create(static_cast<int>(height), static_cast<int>(width), CV_8UC3);
+    d->image.create(static_cast<int>(height), static_cast<int>(width), d->alpha ? CV_8UC4 : CV_8UC3);
     d->rows.resize(height);
     for (png_uint_32 y = 0; y < height; ++y) d->rows[y] = d->image.ptr(static_cast<int>(y));
     png_read_image(d->png, d->rows.data());
@@ -221,8 +228,9 @@ bool runPngDecode(PngDecode* d) {
     return true;
 }
 
-cv::Mat decodePng(const unsigned char* data, std::size_t size) {
+cv::Mat decodePng(const unsigned char* data, std::size_t size, bool alpha = false) {
     PngDecode d;
+    d.alpha = alpha;
     d.io.data = data;
     d.io.size = size;
     d.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &d.io, pngFail, pngWarning);
@@ -370,6 +378,14 @@ cv::Mat decodeImage(const unsigned char* data, std::size_t size) {
     if (size >= 2 && data[0] == 'P' && data[1] >= '1' && data[1] <= '4')
         throw ImageDecodeError("is a text or 1-bit PNM (P1-P4); save it as binary PPM (P6), PNG or JPEG");
     throw ImageDecodeError("is not a JPEG, PNG, BMP or PNM image");
+}
+
+cv::Mat decodeImageWithAlpha(const unsigned char* data, std::size_t size) {
+    static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    if (size >= 8 && std::memcmp(data, kPng, 8) == 0) return decodePng(data, size, true);
+    cv::Mat bgra;
+    cv::cvtColor(decodeImage(data, size), bgra, cv::COLOR_BGR2BGRA);
+    return bgra;
 }
 
 std::string encodeJpeg(const cv::Mat& image, int quality) {

@@ -26,6 +26,8 @@ public:
 // dark picture), a JPEG's EXIF orientation is applied. The format is taken from the data's first bytes, not from
 // a file name. Throws ImageDecodeError.
 cv::Mat decodeImage(const unsigned char* data, std::size_t size);
+// The same as 8-bit BGRA: a PNG's alpha (or tRNS transparency) kept, every other image opaque.
+cv::Mat decodeImageWithAlpha(const unsigned char* data, std::size_t size);
 
 // JPEG bytes of an 8-bit grey, BGR or BGRA image (alpha dropped) at `quality` (1-100), 4:2:0 like libjpeg's
 // defaults. Throws std::runtime_error when the image is not 8-bit with 1, 3 or 4 channels.

@@ -30,7 +30,9 @@ std::string encodeImage(const cv::Mat& image, const std::string& ext, int jpegQu
     throw BoothError(ErrorKind::Internal, "", "could not encode an image as " + ext + " (only .jpg and .png are written)");
 }
 
-cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) {
+namespace {
+
+cv::Mat readChecked(const fs::path& path, const PhotoLimits& limits, bool alpha) {
     const std::string file = readFileBytes(path);
     if (file.empty()) bad(path, "is empty (0 bytes)");
     const std::span<const unsigned char> bytes(reinterpret_cast<const unsigned char*>(file.data()), file.size());
@@ -65,7 +67,7 @@ cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) {
                       "; at most " + std::to_string(limits.maxPixels / 1'000'000) + " megapixels)");
     cv::Mat image;
     try {
-        image = decodeImage(bytes.data(), bytes.size());
+        image = alpha ? decodeImageWithAlpha(bytes.data(), bytes.size()) : decodeImage(bytes.data(), bytes.size());
     } catch (const ImageDecodeError& e) {
         bad(path, e.what());
     }
@@ -75,5 +77,11 @@ cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) {
         bad(path, "is too small (" + std::to_string(image.cols) + "x" + std::to_string(image.rows) + ")");
     return image;
 }
+
+}  // namespace
+
+cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) { return readChecked(path, limits, false); }
+
+cv::Mat readImageWithAlpha(const fs::path& path, const PhotoLimits& limits) { return readChecked(path, limits, true); }
 
 }  // namespace avatarbooth

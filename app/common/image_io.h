@@ -20,5 +20,7 @@ std::string encodeImage(const cv::Mat& image, const std::string& ext, int jpegQu
 // Reads a JPEG or PNG (or BMP/PPM) photo as 8-bit BGR. Throws BoothError(BadInput) naming the file and the
 // reason: missing, not a regular file, empty, unknown format, truncated, too large, undecodable.
 cv::Mat readPhoto(const std::filesystem::path& path, const PhotoLimits& limits = {});
+// The same checks, read as 8-bit BGRA (a PNG's alpha kept; other images opaque): textures with transparency.
+cv::Mat readImageWithAlpha(const std::filesystem::path& path, const PhotoLimits& limits = {});
 
 }  // namespace avatarbooth

@@ -1,6 +1,8 @@
 // The photo-to-head pipeline: steps, timings, which photo an error is about, cancellation between steps.
 #include "fit/fit_pipeline.h"
 
+#include "fit/parts/part_colours.h"
+
 #include "common/error.h"
 #include "common/image_io.h"
 #include "fit/face/profile.h"
@@ -205,6 +207,14 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture,
                                  *textureTables_);
     });
+    out.partColours = measurePartColours(front, out.frontLandmarks);
+    out.parts = placeParts(base_, out.fit.mesh, out.texture.texture, out.partColours);
+    // The brows onto the photo's own (which the texture shows where the fit put dlib's brow points): dlib puts them on
+    // a brow's upper half, about 1.5 mm over its middle (the FRMDB overlays).
+    std::vector<glm::dvec2> browPoints;
+    for (int k = 17; k <= 26; ++k) browPoints.push_back(out.fit.front.toHead(out.frontLandmarks.points[static_cast<std::size_t>(k)]));
+    for (AvatarPart& part : out.parts)
+        if (part.name == "eyebrows") alignToPoints(part, out.fit.mesh, browPoints, 1.5);
     return out;
 }
 

@@ -11,6 +11,7 @@
 #include "fit/head/base_head.h"
 #include "fit/head/head_fit.h"
 #include "fit/head/photo_texture.h"
+#include "fit/parts/avatar_parts.h"
 
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>
@@ -56,6 +57,11 @@ struct FitOutcome {
     HairEstimate hair;  // the hair style, its colour, beard and moustache (fit/face/hair_analysis.h)
     HeadFit fit;
     PhotoTexture texture;
+    // The avatar as shown and exported (fit/parts/avatar_part.h): the head (fit.mesh without what the proxies
+    // replace, with texture.texture), then the base head's proxies placed on fit.mesh, coloured from the front photo
+    // (partColours).
+    std::vector<AvatarPart> parts;
+    PartColours partColours;
     // The base head's named feature vertices where the fit put them (head-space millimetres).
     std::vector<std::pair<std::string, glm::dvec3>> featurePoints;
     RbfOptions rbf;                 // the warp the fit used

@@ -136,20 +136,24 @@ uniform bool uLit;
 uniform vec3 uKeyDir;
 uniform vec3 uFillDir;
 uniform vec3 uWeights;  // ambient, key, fill
+uniform int uAlphaMode;  // 0 opaque, 1 mask, 2 blend (AlphaMode)
+uniform float uAlphaCutoff;
 in vec3 vNormal;
 in float vDepth;
 centroid in vec2 vUv;
 layout(location = 0) out vec4 oColour;
 layout(location = 1) out vec4 oDepth;  // r: depth, g: coverage (resolves to the covered fraction)
 void main() {
-    vec3 colour = texture(uTexture, vUv).rgb;
+    vec4 texel = texture(uTexture, vUv);
+    if (uAlphaMode == 1 && texel.a < uAlphaCutoff) discard;
+    vec3 colour = texel.rgb;
     if (uLit) {
         vec3 n = normalize(vNormal);
         if (!gl_FrontFacing) n = -n;  // inside of an open mesh: light it as its own surface
         float light = uWeights.x + uWeights.y * max(dot(n, uKeyDir), 0.0) + uWeights.z * max(dot(n, uFillDir), 0.0);
         colour = min(colour * light, vec3(1.0));
     }
-    oColour = vec4(colour, 1.0);
+    oColour = vec4(colour, uAlphaMode == 2 ? texel.a : 1.0);
     oDepth = vec4(vDepth, 1.0, 0.0, 0.0);
 }
 )";
@@ -188,15 +192,22 @@ int maxSamples(GLenum format) {
 
 // GL names and uniform locations; 0 = not created.
 struct MeshRenderer::Gl {
-    GLuint program = 0, vao = 0, vertexBuffer = 0, indexBuffer = 0, texture = 0;
+    // One uploaded part: its range in the index buffer, its texture and how its alpha is used.
+    struct Part {
+        GLsizei firstIndex = 0, indexCount = 0;
+        GLuint texture = 0;
+        AlphaMode alpha = AlphaMode::Opaque;
+        float alphaCutoff = 0.5f;
+    };
+    GLuint program = 0, vao = 0, vertexBuffer = 0, indexBuffer = 0;
+    std::vector<Part> parts;  // in drawing order: opaque, masked, blended
     GLint uMvp = -1, uModelView = -1, uNormalMatrix = -1, uLit = -1, uKeyDir = -1, uFillDir = -1, uWeights = -1,
-          uTexture = -1;
+          uTexture = -1, uAlphaMode = -1, uAlphaCutoff = -1;
     GLuint msaaFbo = 0, msaaColour = 0, msaaDepthCoverage = 0, msaaDepth = 0;
     GLuint resolveFbo = 0, resolveColour = 0, resolveDepthCoverage = 0, resolveDepth = 0;
     int width = 0, height = 0;
     GLint maxRenderSize = 0;
     GLint maxTextureSize = 0;
-    GLsizei indexCount = 0;
     glm::dvec3 origin{0.0};  // the mesh centre: vertices are stored relative to it (float precision)
 };
 
@@ -333,6 +344,8 @@ void MeshRenderer::createPipeline() {
         gl_->uFillDir = glGetUniformLocation(p, "uFillDir");
         gl_->uWeights = glGetUniformLocation(p, "uWeights");
         gl_->uTexture = glGetUniformLocation(p, "uTexture");
+        gl_->uAlphaMode = glGetUniformLocation(p, "uAlphaMode");
+        gl_->uAlphaCutoff = glGetUniformLocation(p, "uAlphaCutoff");
 
         glGenVertexArrays(1, &gl_->vao);
         glGenBuffers(1, &gl_->vertexBuffer);
@@ -441,11 +454,7 @@ void MeshRenderer::releaseAll() {
         --liveObjects_;
         gl_->vao = 0;
     }
-    if (gl_->texture != 0) {
-        glDeleteTextures(1, &gl_->texture);
-        --liveObjects_;
-        gl_->texture = 0;
-    }
+    dropTextures();
     if (gl_->program != 0) {
         glDeleteProgram(gl_->program);
         --liveObjects_;
@@ -453,66 +462,106 @@ void MeshRenderer::releaseAll() {
     }
 }
 
+void MeshRenderer::dropTextures() {
+    for (auto& part : gl_->parts)
+        if (part.texture != 0) {
+            glDeleteTextures(1, &part.texture);
+            --liveObjects_;
+        }
+    gl_->parts.clear();
+}
+
 void MeshRenderer::upload(const Mesh& mesh, const cv::Mat& textureBgr) {
-    const std::size_t n = mesh.positions.size();
-    if (!mesh.uvs.empty() && mesh.uvs.size() != n)
-        fail("the mesh has " + std::to_string(mesh.uvs.size()) + " uvs for " + std::to_string(n) + " positions");
-    for (const auto& t : mesh.triangles)
-        if (t.x >= n || t.y >= n || t.z >= n)
-            fail("a triangle refers to vertex " + std::to_string(std::max({t.x, t.y, t.z})) + " of " +
-                 std::to_string(n));
-    if (mesh.triangles.size() > static_cast<std::size_t>(std::numeric_limits<GLsizei>::max() / 3))
+    AvatarPart part;
+    part.mesh = mesh;
+    part.texture = textureBgr;
+    upload(std::vector<AvatarPart>{std::move(part)});
+}
+
+void MeshRenderer::upload(const std::vector<AvatarPart>& parts) {
+    std::size_t vertexTotal = 0, triangleTotal = 0;
+    for (const AvatarPart& part : parts) {
+        const Mesh& mesh = part.mesh;
+        const std::size_t n = mesh.positions.size();
+        if (!mesh.uvs.empty() && mesh.uvs.size() != n)
+            fail("the mesh has " + std::to_string(mesh.uvs.size()) + " uvs for " + std::to_string(n) + " positions");
+        for (const auto& t : mesh.triangles)
+            if (t.x >= n || t.y >= n || t.z >= n)
+                fail("a triangle refers to vertex " + std::to_string(std::max({t.x, t.y, t.z})) + " of " +
+                     std::to_string(n));
+        vertexTotal += n;
+        triangleTotal += mesh.triangles.size();
+    }
+    if (triangleTotal > static_cast<std::size_t>(std::numeric_limits<GLsizei>::max() / 3) ||
+        vertexTotal > std::numeric_limits<std::uint32_t>::max())
         fail("the mesh has too many triangles");
     makeCurrent();
     const int textureLimit =
         options_.maxTextureSize > 0 ? std::min(options_.maxTextureSize, gl_->maxTextureSize) : gl_->maxTextureSize;
-    const cv::Mat rgba = toRgba(textureBgr, textureLimit);
 
-    glm::dvec3 lo(0.0), hi(0.0);
-    if (n > 0) mesh.bounds(lo, hi);
-    gl_->origin = (lo + hi) * 0.5;
-    const std::vector<glm::dvec3> normals = weldedNormals(mesh);
-    std::vector<Vertex> vertices(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        const glm::vec3 p(mesh.positions[i] - gl_->origin);
-        const glm::vec3 nrm(normals[i]);
-        const glm::vec2 uv = mesh.uvs.empty() ? glm::vec2(0.0f) : glm::vec2(mesh.uvs[i]);
-        vertices[i] = Vertex{{p.x, p.y, p.z}, {nrm.x, nrm.y, nrm.z}, {uv.x, uv.y}};
+    // All parts in one vertex and one index buffer, relative to the centre of them all (float precision).
+    glm::dvec3 lo(1e300), hi(-1e300);
+    for (const AvatarPart& part : parts)
+        if (!part.mesh.positions.empty()) {
+            glm::dvec3 partLo, partHi;
+            part.mesh.bounds(partLo, partHi);
+            lo = glm::min(lo, partLo);
+            hi = glm::max(hi, partHi);
+        }
+    gl_->origin = vertexTotal > 0 ? (lo + hi) * 0.5 : glm::dvec3(0.0);
+    std::vector<Vertex> vertices;
+    vertices.reserve(vertexTotal);
+    std::vector<std::uint32_t> indices;
+    indices.reserve(3 * triangleTotal);
+    dropTextures();
+    for (const AvatarPart* part : drawOrder(parts)) {
+        const Mesh& mesh = part->mesh;
+        const auto base = static_cast<std::uint32_t>(vertices.size());
+        const std::vector<glm::dvec3> normals = weldedNormals(mesh);
+        for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+            const glm::vec3 p(mesh.positions[i] - gl_->origin);
+            const glm::vec3 nrm(normals[i]);
+            const glm::vec2 uv = mesh.uvs.empty() ? glm::vec2(0.0f) : glm::vec2(mesh.uvs[i]);
+            vertices.push_back(Vertex{{p.x, p.y, p.z}, {nrm.x, nrm.y, nrm.z}, {uv.x, uv.y}});
+        }
+        Gl::Part drawn;
+        drawn.firstIndex = static_cast<GLsizei>(indices.size());
+        for (const auto& t : mesh.triangles) indices.insert(indices.end(), {base + t.x, base + t.y, base + t.z});
+        drawn.indexCount = static_cast<GLsizei>(indices.size()) - drawn.firstIndex;
+        drawn.alpha = part->alpha;
+        drawn.alphaCutoff = static_cast<float>(part->alphaCutoff);
+
+        const cv::Mat rgba = toRgba(part->texture, textureLimit);
+        glGenTextures(1, &drawn.texture);  // storage is immutable: new textures for each upload
+        ++liveObjects_;
+        gl_->parts.push_back(drawn);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, drawn.texture);
+        const int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(rgba.cols, rgba.rows))));
+        glTexStorage2D(GL_TEXTURE_2D, levels, GL_RGBA8, rgba.cols, rgba.rows);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
+        glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, rgba.cols, rgba.rows, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+        glGenerateMipmap(GL_TEXTURE_2D);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     }
+    glBindTexture(GL_TEXTURE_2D, 0);
     glBindVertexArray(gl_->vao);
     glBindBuffer(GL_ARRAY_BUFFER, gl_->vertexBuffer);
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(),
                  GL_STATIC_DRAW);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.triangles.size() * sizeof(glm::uvec3)),
-                 mesh.triangles.data(), GL_STATIC_DRAW);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)),
+                 indices.data(), GL_STATIC_DRAW);
     glBindVertexArray(0);
-    gl_->indexCount = static_cast<GLsizei>(mesh.triangles.size() * 3);
-
-    if (gl_->texture != 0) {  // storage is immutable: a new texture for each upload
-        glDeleteTextures(1, &gl_->texture);
-        --liveObjects_;
-    }
-    glGenTextures(1, &gl_->texture);
-    ++liveObjects_;
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, gl_->texture);
-    const int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(rgba.cols, rgba.rows))));
-    glTexStorage2D(GL_TEXTURE_2D, levels, GL_RGBA8, rgba.cols, rgba.rows);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
-    glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
-    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, rgba.cols, rgba.rows, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
-    glGenerateMipmap(GL_TEXTURE_2D);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glBindTexture(GL_TEXTURE_2D, 0);
     checkGl("uploading the mesh and its texture");
-    vertexCount_ = n;
-    triangleCount_ = mesh.triangles.size();
+    vertexCount_ = vertexTotal;
+    triangleCount_ = triangleTotal;
 }
 
 void MeshRenderer::drawScene(const RenderCamera& camera, bool withDepth) {
@@ -552,7 +601,7 @@ void MeshRenderer::drawScene(const RenderCamera& camera, bool withDepth) {
     if (withDepth) glClearBufferfv(GL_COLOR, 1, nothing);
     glClearBufferfv(GL_DEPTH, 0, &far);
 
-    if (gl_->indexCount > 0) {
+    if (triangleCount_ > 0) {
         const glm::dmat4 model = glm::translate(glm::dmat4(1.0), gl_->origin);
         const glm::dmat4 modelView = camera.view * model;
         const glm::mat4 mvp(camera.projection * modelView);
@@ -569,9 +618,28 @@ void MeshRenderer::drawScene(const RenderCamera& camera, bool withDepth) {
         glUniform3f(gl_->uWeights, static_cast<float>(kAmbient), static_cast<float>(kKey), static_cast<float>(kFill));
         glUniform1i(gl_->uTexture, 0);
         glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, gl_->texture);
         glBindVertexArray(gl_->vao);
-        glDrawElements(GL_TRIANGLES, gl_->indexCount, GL_UNSIGNED_INT, nullptr);
+        // Opaque and masked parts first, then the blended ones over them: blended over what is drawn, without
+        // writing depth (they do not hide each other) nor the depth and coverage target (float targets do not blend).
+        for (const Gl::Part& part : gl_->parts) {
+            if (part.indexCount == 0) continue;
+            const bool blend = part.alpha == AlphaMode::Blend;
+            if (blend) {
+                const GLenum colourOnly[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+                glDrawBuffers(targets, colourOnly);
+                glEnable(GL_BLEND);
+                glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+                glDepthMask(GL_FALSE);
+            }
+            glUniform1i(gl_->uAlphaMode, static_cast<int>(part.alpha));
+            glUniform1f(gl_->uAlphaCutoff, part.alphaCutoff);
+            glBindTexture(GL_TEXTURE_2D, part.texture);
+            glDrawElements(GL_TRIANGLES, part.indexCount, GL_UNSIGNED_INT,
+                           reinterpret_cast<const void*>(static_cast<std::size_t>(part.firstIndex) * sizeof(std::uint32_t)));
+        }
+        glDisable(GL_BLEND);
+        glDepthMask(GL_TRUE);
+        glDrawBuffers(targets, both);
         glBindVertexArray(0);
         glBindTexture(GL_TEXTURE_2D, 0);
         glUseProgram(0);

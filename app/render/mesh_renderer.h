@@ -1,7 +1,9 @@
-// Offscreen rendering of one textured head mesh into colour, coverage mask and depth images (OpenGL ES 3).
+// Offscreen rendering of a textured head mesh, or of the avatar's parts (fit/parts/avatar_part.h), into colour,
+// coverage mask and depth images (OpenGL ES 3).
 #pragma once
 
 #include "fit/head/mesh.h"
+#include "fit/parts/avatar_part.h"
 
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>
@@ -9,6 +11,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace avatarbooth {
 
@@ -88,13 +91,17 @@ public:
     // Uploads a mesh and its texture (8-bit BGR, grey or BGRA, any size; empty = plain light grey), replacing any
     // previous one. Mesh uvs may be empty (the whole mesh takes the texture's top-left colour).
     void upload(const Mesh& mesh, const cv::Mat& textureBgr);
+    // Uploads the avatar's parts, each with its texture, replacing what was uploaded. They are drawn opaque first,
+    // then masked (fragments under the cutoff dropped), then blended over them without writing depth; RenderResult's
+    // depth and coverage come from the opaque and masked parts, its colour and mask from all.
+    void upload(const std::vector<AvatarPart>& parts);
     // Renders the uploaded mesh with the given camera (the background alone when nothing was uploaded).
     RenderResult render(const RenderCamera& camera);
     // The same render as one BGRA image (lit colour, coverage as alpha) written into `bgra` (reallocated only when
     // the size changes): the cheapest read-back, for a render shown on screen every frame. No depth is made.
     void renderBgra(const RenderCamera& camera, cv::Mat& bgra);
 
-    // Vertex and triangle counts of the uploaded mesh (0 before upload()).
+    // Vertex and triangle counts of the uploaded mesh, all parts together (0 before upload()).
     std::size_t vertexCount() const { return vertexCount_; }
     std::size_t triangleCount() const { return triangleCount_; }
     // Samples per pixel of the offscreen buffers (4 where the GPU allows, else fewer; 1 = no anti-aliasing).
@@ -111,6 +118,7 @@ private:
     void destroyTargets();
     void ensureTargets(int width, int height);
     void releaseAll();
+    void dropTextures();
     void bindResolvedForReadBack();
     void drawScene(const RenderCamera& camera, bool withDepth);
 

@@ -74,6 +74,17 @@ PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size) {
     return set;
 }
 
+PreviewSet renderPreviews(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size) {
+    // One mesh of all the parts, for the framing and the check that they are the ones uploaded.
+    Mesh all;
+    for (const AvatarPart& part : parts) {
+        const auto base = static_cast<std::uint32_t>(all.positions.size());
+        all.positions.insert(all.positions.end(), part.mesh.positions.begin(), part.mesh.positions.end());
+        for (const auto& t : part.mesh.triangles) all.triangles.push_back(t + glm::uvec3(base));
+    }
+    return renderPreviews(renderer, all, size);
+}
+
 std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames) {
     checkUploaded(renderer, mesh, size);
     glm::dvec3 lo, hi;

@@ -22,6 +22,9 @@ struct PreviewSet {
 // the uploaded one.
 PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size = 512);
 
+// The same of the avatar's parts (all uploaded to `renderer` with MeshRenderer::upload(parts)), framed to them all.
+PreviewSet renderPreviews(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size = 512);
+
 // The three-quarter view alone (the same picture as PreviewSet::threeQuarter), for a second mesh such as the
 // character: the same checks.
 cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size = 512);

@@ -63,9 +63,14 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
                 person, std::get<1>(GetParam()), outcome.fit.modifierRmsMm.first, outcome.fit.modifierRmsMm.second,
                 outcome.fit.foldsRemoved, std::sqrt(sum / static_cast<double>(std::max<std::size_t>(outcome.fit.residuals.size(), 1))));
     EXPECT_TRUE(folds.empty()) << folds.size() << " triangles turned over";
-    // The glb reads back with the same mesh.
+    // The glb reads back with the same head (its first part: the fitted head without the eyeballs the eyes replace).
     const Mesh back = readGlbMesh(out / "avatar.glb");
-    EXPECT_EQ(back.positions.size(), mesh.positions.size());
+    ASSERT_FALSE(outcome.parts.empty());
+    EXPECT_EQ(back.positions.size(), outcome.parts.front().mesh.positions.size());
+    std::printf("%s %s: parts", person, std::get<1>(GetParam()));
+    for (const auto& part : outcome.parts) std::printf(" %s", part.name.c_str());
+    for (const auto& [name, c] : outcome.partColours) std::printf("; %s (%.0f %.0f %.0f)", name.c_str(), c[0], c[1], c[2]);
+    std::printf("\n");
 }
 
 INSTANTIATE_TEST_SUITE_P(AllPeople, FrmdbFit,

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 
 #include <unistd.h>
@@ -71,6 +72,15 @@ TEST(FitCli, WritesACompleteSessionFolderWithAValidGlb) {
     while (fgets(buf.data(), buf.size(), pipe)) report += buf.data();
     EXPECT_EQ(pclose(pipe), 0) << report;
     EXPECT_NE(report.find("\"errors\":0"), std::string::npos) << report;
+    // With the product's base head the avatar is made of parts, one node each: the brows blended, the lashes masked.
+    const std::string glb = readBytes(out / "avatar.glb");
+    ASSERT_GT(glb.size(), 20u);
+    std::uint32_t jsonLength = 0;
+    std::memcpy(&jsonLength, glb.data() + 12, 4);
+    const std::string json = glb.substr(20, jsonLength);
+    for (const char* node : {"\"name\":\"head\"", "\"name\":\"eyes\"", "\"name\":\"eyebrows\"", "\"name\":\"eyelashes\"",
+                             "\"alphaMode\":\"BLEND\"", "\"alphaMode\":\"MASK\""})
+        EXPECT_NE(json.find(node), std::string::npos) << node;
     // The previews show a head, not an empty grey square.
     const cv::Mat preview = cv::imread((out / "preview_front.png").string());
     ASSERT_FALSE(preview.empty());

@@ -425,6 +425,45 @@ TEST_F(RenderMesh, HundredRendersGiveTheSameImagesAndHoldNoNewGlObjects) {
 
 // ---- contexts ---------------------------------------------------------------------------------------------------
 
+// Parts: an opaque red square behind; in front a blended square of blue at alpha 0.5 over its left half and a masked
+// square whose right half is under its cutoff. Blended over red, masked dropped where under the cutoff, the masked
+// part hiding the red where kept; and the blended part writes no depth (the opaque part behind keeps its depth).
+TEST(RenderParts, OpaqueThenMaskedThenBlended) {
+    std::vector<AvatarPart> parts(3);
+    parts[0].mesh = square(80.0, {0, 0, -10});
+    parts[0].texture = cv::Mat(8, 8, CV_8UC3, cv::Scalar(0, 0, 255));
+    parts[1].mesh = square(40.0, {-20, 0, 10});  // covers x -40..0
+    parts[1].texture = cv::Mat(8, 8, CV_8UC4, cv::Scalar(255, 0, 0, 128));
+    parts[1].alpha = AlphaMode::Blend;
+    parts[2].mesh = square(40.0, {20, 0, 10});  // covers x 0..40
+    cv::Mat masked(8, 8, CV_8UC4, cv::Scalar(0, 255, 0, 255));
+    masked(cv::Rect(4, 0, 4, 8)).setTo(cv::Scalar(0, 255, 0, 20));
+    parts[2].texture = masked;
+    parts[2].alpha = AlphaMode::Mask;
+    parts[2].alphaCutoff = 0.5;
+    // Listed blended first: the renderer orders them itself.
+    MeshRenderer renderer;
+    renderer.upload(parts);
+    EXPECT_EQ(renderer.triangleCount(), 6u);
+    RenderCamera camera = RenderCamera::orthographic({0, 0, 500}, {0, 0, 0}, {0, 1, 0}, 0.5, 200, 200);
+    camera.lit = false;
+    const RenderResult r = renderer.render(camera);
+    const auto at = [&](double x, double y) {
+        const glm::dvec2 p = camera.project({x, y, 0});
+        return cv::Point(static_cast<int>(p.x), static_cast<int>(p.y));
+    };
+    const cv::Vec3b blended = r.bgr.at<cv::Vec3b>(at(-20, 0));
+    EXPECT_NEAR(blended[0], 128, 3);
+    EXPECT_NEAR(blended[2], 127, 3);
+    EXPECT_EQ(r.bgr.at<cv::Vec3b>(at(10, 0)), kGreen);   // masked, kept
+    EXPECT_EQ(r.bgr.at<cv::Vec3b>(at(30, 0)), kRed);     // masked, under the cutoff
+    EXPECT_EQ(r.bgr.at<cv::Vec3b>(at(-35, 30)), kRed);   // opaque alone
+    EXPECT_EQ(r.mask.at<std::uint8_t>(at(-20, 0)), 255);
+    // Depth: the blended square's pixels keep the opaque square's distance (510 mm), the masked one's its own.
+    EXPECT_NEAR(r.depth.at<float>(at(-20, 0)), 510.0f, 0.5f);
+    EXPECT_NEAR(r.depth.at<float>(at(10, 0)), 490.0f, 0.5f);
+}
+
 TEST(RenderEgl, ContextReportsItsRenderer) {
     HeadlessEglContext context;
     EXPECT_FALSE(context.renderer().empty());

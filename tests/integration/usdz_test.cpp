@@ -186,3 +186,45 @@ TEST(Usdz, LayerMeshMatchesTheGlb) {
     ASSERT_TRUE(std::regex_search(usda, st, std::regex(R"(primvars:st = \[\(([-0-9.e]+), ([-0-9.e]+)\))")));
     EXPECT_NEAR(std::stod(st[2]), 1.0 - glb.uvs[0].y, 1e-6);
 }
+
+// The avatar's parts: one Mesh and one Material each, the head's as before; a blended part's opacity is its
+// texture's alpha, a masked one's with its threshold; every texture in the archive, PNG where the alpha counts.
+TEST(Usdz, CarriesEveryPart) {
+    const fs::path dir = test::scratchDir("usdz_parts");
+    std::vector<AvatarPart> parts(3);
+    parts[0].name = "head";
+    parts[0].mesh = sphere(12, 24);
+    parts[0].texture = texture();
+    parts[1].name = "eyebrows";
+    parts[1].mesh = sphere(4, 8);
+    parts[1].texture = cv::Mat(16, 16, CV_8UC4, cv::Scalar(20, 30, 40, 100));
+    parts[1].alpha = AlphaMode::Blend;
+    parts[2].name = "eyelashes";
+    parts[2].mesh = sphere(4, 8);
+    parts[2].texture = cv::Mat(16, 16, CV_8UC4, cv::Scalar(0, 0, 0, 255));
+    parts[2].alpha = AlphaMode::Mask;
+    parts[2].alphaCutoff = 0.3;
+    writeFileAtomically(dir / "avatar.usdz", encodeUsdz(parts));
+    const std::string script = R"PY(
+import sys, zipfile
+z = zipfile.ZipFile(sys.argv[1])
+assert z.testzip() is None, "bad CRC"
+assert z.namelist() == ["avatar.usda", "texture.jpg", "eyebrows.png", "eyelashes.png"], z.namelist()
+assert z.read("eyebrows.png")[:4] == b"\x89PNG"
+layer = z.read("avatar.usda").decode("ascii")
+for needle in ['def Mesh "head"', 'def Mesh "eyebrows"', 'def Mesh "eyelashes"', 'def Material "skin"',
+               'def Material "eyebrows"', 'rel material:binding = </avatar/Materials/eyelashes>',
+               'float inputs:opacity.connect = </avatar/Materials/eyebrows/texture.outputs:a>',
+               'float inputs:opacityThreshold = 0.3', 'asset inputs:file = @eyelashes.png@']:
+    assert needle in layer, needle
+assert layer.count("def Mesh") == 3 and layer.count("def Material") == 3
+assert layer.count("opacityThreshold") == 1
+assert layer.count("{") == layer.count("}")
+print("parts ok")
+)PY";
+    {
+        std::ofstream(dir / "check.py") << script;
+    }
+    const std::string out = run("python3 " + (dir / "check.py").string() + " " + (dir / "avatar.usdz").string());
+    EXPECT_NE(out.find("parts ok\nexit 0"), std::string::npos) << out;
+}

@@ -46,14 +46,13 @@ int addAccessor(tinygltf::Model& model, int view, int componentType, int type, s
 
 }  // namespace
 
-std::string encodeGlb(const Mesh& mesh, const cv::Mat& texture, const std::string& name) {
-    if (mesh.positions.empty() || mesh.triangles.empty())
-        throw BoothError(ErrorKind::Internal, "", "cannot export an empty mesh");
-    tinygltf::Model model;
-    model.asset.version = "2.0";
-    model.asset.generator = std::string("avatarbooth ") + AVATARBOOTH_VERSION;
-    model.buffers.resize(1);
+namespace {
 
+// One part as one glTF mesh (one primitive), material, texture and node.
+void addPart(tinygltf::Model& model, const AvatarPart& part) {
+    const Mesh& mesh = part.mesh;
+    if (mesh.positions.empty() || mesh.triangles.empty())
+        throw BoothError(ErrorKind::Internal, "", "cannot export an empty mesh (part '" + part.name + "')");
     const std::size_t n = mesh.positions.size();
     std::vector<float> positions, normals, uvs;
     positions.reserve(3 * n);
@@ -66,8 +65,11 @@ std::string encodeGlb(const Mesh& mesh, const cv::Mat& texture, const std::strin
             hi[static_cast<std::size_t>(c)] = std::max(hi[static_cast<std::size_t>(c)], static_cast<double>(v));
         }
     }
-    for (const auto& nrm : mesh.vertexNormals())
-        for (int c = 0; c < 3; ++c) normals.push_back(static_cast<float>(nrm[c]));
+    for (const auto& nrm : mesh.vertexNormals()) {
+        // A vertex of no area (an unused one, a degenerate fan) gets some unit normal: glTF asks for unit length.
+        const glm::dvec3 unit = glm::length(nrm) > 0.5 ? nrm : glm::dvec3(0.0, 0.0, 1.0);
+        for (int c = 0; c < 3; ++c) normals.push_back(static_cast<float>(unit[c]));
+    }
     for (const auto& uv : mesh.uvs) {
         uvs.push_back(static_cast<float>(uv.x));
         uvs.push_back(static_cast<float>(uv.y));
@@ -93,43 +95,64 @@ std::string encodeGlb(const Mesh& mesh, const cv::Mat& texture, const std::strin
         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size());
 
     tinygltf::Material material;
-    material.name = name + "-skin";
+    material.name = part.name + (part.name == "head" || model.materials.empty() ? "-skin" : "-material");
     material.pbrMetallicRoughness.metallicFactor = 0.0;
     material.pbrMetallicRoughness.roughnessFactor = 0.8;
-    if (!texture.empty() && mesh.uvs.size() == n) {
-        const std::string jpeg = encodeImage(texture, ".jpg", 92);
+    material.alphaMode = toString(part.alpha);
+    if (part.alpha == AlphaMode::Mask) material.alphaCutoff = part.alphaCutoff;
+    // Brows and lashes are cards seen from both sides.
+    material.doubleSided = part.alpha != AlphaMode::Opaque;
+    if (!part.texture.empty() && mesh.uvs.size() == n) {
+        // JPEG for the opaque textures (the photos' head: small), PNG where the alpha matters.
+        const bool withAlpha = part.alpha != AlphaMode::Opaque && part.texture.channels() == 4;
+        const std::string bytes = withAlpha ? encodeImage(part.texture, ".png") : encodeImage(part.texture, ".jpg", 92);
         tinygltf::Image image;
-        image.name = name + "-texture";
-        image.mimeType = "image/jpeg";
-        image.bufferView = addBufferView(model, jpeg.data(), jpeg.size(), 0);
+        image.name = part.name + "-texture";
+        image.mimeType = withAlpha ? "image/png" : "image/jpeg";
+        image.bufferView = addBufferView(model, bytes.data(), bytes.size(), 0);
         model.images.push_back(image);
-        tinygltf::Sampler sampler;
-        sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-        sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
-        sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-        sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-        model.samplers.push_back(sampler);
+        if (model.samplers.empty()) {
+            tinygltf::Sampler sampler;
+            sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+            sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+            sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+            sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+            model.samplers.push_back(sampler);
+        }
         tinygltf::Texture tex;
         tex.sampler = 0;
-        tex.source = 0;
+        tex.source = static_cast<int>(model.images.size() - 1);
         model.textures.push_back(tex);
-        material.pbrMetallicRoughness.baseColorTexture.index = 0;
+        material.pbrMetallicRoughness.baseColorTexture.index = static_cast<int>(model.textures.size() - 1);
     } else {
         material.pbrMetallicRoughness.baseColorFactor = {0.80, 0.62, 0.52, 1.0};
     }
     model.materials.push_back(material);
-    primitive.material = 0;
+    primitive.material = static_cast<int>(model.materials.size() - 1);
 
     tinygltf::Mesh gltfMesh;
-    gltfMesh.name = name;
+    gltfMesh.name = part.name;
     gltfMesh.primitives.push_back(primitive);
     model.meshes.push_back(gltfMesh);
     tinygltf::Node node;
-    node.name = name;
-    node.mesh = 0;
+    node.name = part.name;
+    node.mesh = static_cast<int>(model.meshes.size() - 1);
     model.nodes.push_back(node);
+}
+
+}  // namespace
+
+std::string encodeGlb(const std::vector<AvatarPart>& parts) {
+    if (parts.empty()) throw BoothError(ErrorKind::Internal, "", "cannot export an avatar without parts");
+    tinygltf::Model model;
+    model.asset.version = "2.0";
+    model.asset.generator = std::string("avatarbooth ") + AVATARBOOTH_VERSION;
+    model.buffers.resize(1);
     tinygltf::Scene scene;
-    scene.nodes.push_back(0);
+    for (const AvatarPart& part : parts) {
+        addPart(model, part);
+        scene.nodes.push_back(static_cast<int>(model.nodes.size() - 1));
+    }
     model.scenes.push_back(scene);
     model.defaultScene = 0;
     model.buffers[0].data.resize((model.buffers[0].data.size() + 3) / 4 * 4, 0);
@@ -139,6 +162,14 @@ std::string encodeGlb(const Mesh& mesh, const cv::Mat& texture, const std::strin
     if (!writer.WriteGltfSceneToStream(&model, out, false, true))
         throw BoothError(ErrorKind::Internal, "", "tinygltf could not write the glb");
     return out.str();
+}
+
+std::string encodeGlb(const Mesh& mesh, const cv::Mat& texture, const std::string& name) {
+    AvatarPart part;
+    part.name = name;
+    part.mesh = mesh;
+    part.texture = texture;
+    return encodeGlb(std::vector<AvatarPart>{std::move(part)});
 }
 
 void writeGlb(const std::filesystem::path& path, const Mesh& mesh, const cv::Mat& texture, const std::string& name) {

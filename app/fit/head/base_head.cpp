@@ -118,6 +118,12 @@ void saveFeatureFile(const BaseHead& head, const std::filesystem::path& featureJ
     if (!head.rigidParts.empty()) j["rigid_parts"] = head.rigidParts;
     if (!modifiersFile.empty()) j["modifiers"] = modifiersFile;
     if (!skinFile.empty()) j["skin"] = skinFile;
+    if (!head.proxies.empty()) {
+        const std::filesystem::path dir = featureJson.parent_path() / "parts";
+        std::filesystem::create_directories(dir);
+        auto& list = j["proxies"] = nlohmann::json::array();
+        for (const HeadProxy& p : head.proxies) list.push_back("parts/" + saveHeadProxy(p, dir));
+    }
     writeFileAtomically(featureJson, j.dump(2) + "\n");
 }
 
@@ -168,6 +174,13 @@ BaseHead loadBaseHead(const std::filesystem::path& meshGlb, const std::filesyste
     if (j.contains("skin")) {
         const auto file = beside("skin");
         head.skin = readPhoto(file);
+    }
+    if (j.contains("proxies")) {
+        if (!j["proxies"].is_array()) throw BoothError(ErrorKind::BadConfig, where, "field 'proxies' must be a list of file names");
+        for (const auto& name : j["proxies"]) {
+            if (!name.is_string()) throw BoothError(ErrorKind::BadConfig, where, "field 'proxies' must be a list of file names");
+            head.proxies.push_back(loadHeadProxy(featureJson.parent_path() / name.get<std::string>(), head.mesh.positions));
+        }
     }
     head.frontContour = findContourVertices(head.mesh, head.eyeMidpoint(), 0, defaultFrontContourAngles());
     head.sideContour = findContourVertices(head.mesh, head.earHoleCentre, 1, defaultSideContourAngles());

@@ -4,6 +4,7 @@
 
 #include "fit/head/mesh.h"
 #include "fit/head/modifier_basis.h"
+#include "fit/parts/head_proxy.h"
 
 #include <opencv2/core.hpp>
 
@@ -41,6 +42,9 @@ struct BaseHead {
     std::shared_ptr<const ModifierBasis> modifiers;
     // A skin texture on the head's UVs (BGR) for what no photo sees; empty: the photos' colours are spread there.
     cv::Mat skin;
+    // The meshes bound to this head that become the avatar's other parts (eyes, eyebrows, eyelashes; hair, beard):
+    // head_proxy.h. None for the built-in head.
+    std::vector<HeadProxy> proxies;
 
     // Midpoint of the two eye centres (mean of ibug 36-41 and of 42-47): the front photo's centre.
     glm::dvec3 eyeMidpoint() const;
@@ -65,7 +69,8 @@ std::filesystem::path findMakeHumanBaseHead();
 BaseHead loadBaseHead(const std::filesystem::path& meshGlb, const std::filesystem::path& featureJson);
 
 // Writes the feature file of a base head (its mesh is written with the glb exporter). The modifier basis and skin
-// files, when named, are recorded relative to the feature file, and loadBaseHead reads them from there.
+// files, when named, are recorded relative to the feature file, and loadBaseHead reads them from there. The head's
+// proxies are written into parts/ beside it (saveHeadProxy) and listed in it.
 void saveFeatureFile(const BaseHead& head, const std::filesystem::path& featureJson,
                      const std::string& modifiersFile = "", const std::string& skinFile = "");
 

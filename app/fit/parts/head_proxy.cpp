@@ -1,0 +1,169 @@
+// Head proxies: placing them by their binding, and their files beside the base head.
+#include "fit/parts/head_proxy.h"
+
+#include "common/atomic_output.h"
+#include "common/error.h"
+#include "common/image_io.h"
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <fstream>
+
+namespace avatarbooth {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kFormat = "avatarbooth-head-proxy/1";
+
+AlphaMode alphaModeOf(const std::string& text, const std::string& where) {
+    for (const AlphaMode m : {AlphaMode::Opaque, AlphaMode::Mask, AlphaMode::Blend})
+        if (text == toString(m)) return m;
+    throw BoothError(ErrorKind::BadConfig, where, "field 'alpha' must be OPAQUE, MASK or BLEND (is '" + text + "')");
+}
+
+}  // namespace
+
+const char* toString(AlphaMode mode) {
+    switch (mode) {
+        case AlphaMode::Opaque: return "OPAQUE";
+        case AlphaMode::Mask: return "MASK";
+        case AlphaMode::Blend: return "BLEND";
+    }
+    return "OPAQUE";
+}
+
+std::vector<const AvatarPart*> drawOrder(const std::vector<AvatarPart>& parts) {
+    std::vector<const AvatarPart*> out;
+    for (const AlphaMode mode : {AlphaMode::Opaque, AlphaMode::Mask, AlphaMode::Blend})
+        for (const AvatarPart& p : parts)
+            if (p.alpha == mode) out.push_back(&p);
+    return out;
+}
+
+std::vector<glm::dvec3> placeProxy(const ProxyBinding& b, const std::vector<glm::dvec3>& head) {
+    if (b.weights.size() != b.vertices.size() || b.offsets.size() != b.vertices.size())
+        throw BoothError(ErrorKind::Internal, "proxy binding",
+                         "has " + std::to_string(b.vertices.size()) + " vertex triples, " + std::to_string(b.weights.size()) +
+                             " weights and " + std::to_string(b.offsets.size()) + " offsets");
+    std::vector<glm::dvec3> out(b.vertices.size());
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        glm::dvec3 p = b.offsets[i];
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t v = b.vertices[i][static_cast<std::size_t>(k)];
+            if (v >= head.size())
+                throw BoothError(ErrorKind::Internal, "proxy binding",
+                                 "refers to vertex " + std::to_string(v) + " of a head with " + std::to_string(head.size()));
+            p += b.weights[i][k] * head[v];
+        }
+        out[i] = p;
+    }
+    return out;
+}
+
+std::string saveHeadProxy(const HeadProxy& p, const fs::path& dir) {
+    nlohmann::json j;
+    j["format"] = kFormat;
+    j["name"] = p.name;
+    j["source"] = p.source;
+    j["alpha"] = toString(p.alpha);
+    j["alpha_cutoff"] = p.alphaCutoff;
+    j["units"] = "offsets in millimetres; uvs with (0, 0) the texture's top-left corner";
+    auto& vertices = j["binding"]["vertices"] = nlohmann::json::array();
+    auto& weights = j["binding"]["weights"] = nlohmann::json::array();
+    auto& offsets = j["binding"]["offsets"] = nlohmann::json::array();
+    for (std::size_t i = 0; i < p.binding.vertices.size(); ++i) {
+        vertices.push_back(p.binding.vertices[i]);
+        weights.push_back({p.binding.weights[i].x, p.binding.weights[i].y, p.binding.weights[i].z});
+        offsets.push_back({p.binding.offsets[i].x, p.binding.offsets[i].y, p.binding.offsets[i].z});
+    }
+    auto& uvs = j["uvs"] = nlohmann::json::array();
+    for (const auto& uv : p.mesh.uvs) uvs.push_back({uv.x, uv.y});
+    auto& triangles = j["triangles"] = nlohmann::json::array();
+    for (const auto& t : p.mesh.triangles) triangles.push_back({t.x, t.y, t.z});
+    j["replaces"] = p.replaces;
+    j["texture"] = p.name + ".png";
+    writeFileAtomically(dir / (p.name + ".png"), encodeImage(p.texture, ".png"));
+    if (!p.tintMask.empty()) {
+        j["tint_mask"] = p.name + ".tint.png";
+        writeFileAtomically(dir / (p.name + ".tint.png"), encodeImage(p.tintMask, ".png"));
+    }
+    const std::string file = p.name + ".json";
+    writeFileAtomically(dir / file, j.dump() + "\n");
+    return file;
+}
+
+HeadProxy loadHeadProxy(const fs::path& file, const std::vector<glm::dvec3>& head) {
+    const std::string where = file.string();
+    std::ifstream in(file);
+    if (!in) throw BoothError(ErrorKind::BadConfig, where, "cannot be opened");
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::parse_error& e) {
+        throw BoothError(ErrorKind::BadConfig, where, std::string("is not valid JSON: ") + e.what());
+    }
+    HeadProxy p;
+    const auto field = [&](const char* key) -> const nlohmann::json& {
+        if (!j.contains(key)) throw BoothError(ErrorKind::BadConfig, where, std::string("missing field '") + key + "'");
+        return j[key];
+    };
+    try {
+        if (field("format") != kFormat)
+            throw BoothError(ErrorKind::BadConfig, where, std::string("field 'format' must be ") + kFormat);
+        p.name = field("name").get<std::string>();
+        p.source = j.value("source", "");
+        p.alpha = alphaModeOf(field("alpha").get<std::string>(), where);
+        p.alphaCutoff = j.value("alpha_cutoff", 0.5);
+        const auto& b = field("binding");
+        const auto& vertices = b.at("vertices");
+        const auto& weights = b.at("weights");
+        const auto& offsets = b.at("offsets");
+        if (weights.size() != vertices.size() || offsets.size() != vertices.size())
+            throw BoothError(ErrorKind::BadConfig, where, "field 'binding' has lists of different lengths");
+        for (std::size_t i = 0; i < vertices.size(); ++i) {
+            std::array<std::uint32_t, 3> v{};
+            for (std::size_t k = 0; k < 3; ++k) {
+                v[k] = vertices.at(i).at(k).get<std::uint32_t>();
+                if (v[k] >= head.size())
+                    throw BoothError(ErrorKind::BadConfig, where, "field 'binding.vertices' refers to vertex " + std::to_string(v[k]) +
+                                                                      " of a base head with " + std::to_string(head.size()));
+            }
+            p.binding.vertices.push_back(v);
+            p.binding.weights.emplace_back(weights.at(i).at(0).get<double>(), weights.at(i).at(1).get<double>(), weights.at(i).at(2).get<double>());
+            p.binding.offsets.emplace_back(offsets.at(i).at(0).get<double>(), offsets.at(i).at(1).get<double>(), offsets.at(i).at(2).get<double>());
+        }
+        for (const auto& uv : field("uvs")) p.mesh.uvs.emplace_back(uv.at(0).get<double>(), uv.at(1).get<double>());
+        if (p.mesh.uvs.size() != vertices.size())
+            throw BoothError(ErrorKind::BadConfig, where, "field 'uvs' has " + std::to_string(p.mesh.uvs.size()) + " for " +
+                                                              std::to_string(vertices.size()) + " vertices");
+        for (const auto& t : field("triangles")) {
+            const glm::uvec3 tri(t.at(0).get<std::uint32_t>(), t.at(1).get<std::uint32_t>(), t.at(2).get<std::uint32_t>());
+            if (tri.x >= vertices.size() || tri.y >= vertices.size() || tri.z >= vertices.size())
+                throw BoothError(ErrorKind::BadConfig, where, "field 'triangles' refers past the " + std::to_string(vertices.size()) + " vertices");
+            p.mesh.triangles.push_back(tri);
+        }
+        for (const auto& v : j.value("replaces", nlohmann::json::array())) {
+            if (v.get<std::uint64_t>() >= head.size())
+                throw BoothError(ErrorKind::BadConfig, where, "field 'replaces' refers past the base head's vertices");
+            p.replaces.push_back(v.get<std::uint32_t>());
+        }
+        PhotoLimits textureLimits;
+        textureLimits.minSide = 1;  // a texture may be small; the photos' lower limit is for faces
+        p.texture = readImageWithAlpha(file.parent_path() / field("texture").get<std::string>(), textureLimits);
+        if (p.alpha == AlphaMode::Opaque) cv::cvtColor(p.texture, p.texture, cv::COLOR_BGRA2BGR);
+        if (j.contains("tint_mask")) {
+            cv::Mat mask = readPhoto(file.parent_path() / j["tint_mask"].get<std::string>(), textureLimits);
+            cv::extractChannel(mask, p.tintMask, 0);
+            if (p.tintMask.size() != p.texture.size())
+                throw BoothError(ErrorKind::BadConfig, where, "its tint mask and texture differ in size");
+        }
+    } catch (const nlohmann::json::exception& e) {
+        throw BoothError(ErrorKind::BadConfig, where, std::string("not a head proxy as expected: ") + e.what());
+    }
+    p.mesh.positions = placeProxy(p.binding, head);
+    return p;
+}
+
+}  // namespace avatarbooth
