@@ -7,6 +7,7 @@
 #include "common/landmark_names.h"
 #include "fit/face/profile.h"
 #include "fit/head/surface_texels.h"
+#include "fit/parts/hair_part.h"
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
@@ -210,6 +211,12 @@ std::pair<MakeHumanPerson, Look> draw(const ModifierBasis& basis, unsigned seed)
     // --- Issue 22's hair and beard, from a generator of their own, so that the people drawn before stay the same.
     Rng hairRng(seed * 40503u + 977u);
     p.hairStyle = look.bald || look.balding ? "none" : "short";
+    if (p.hairStyle != "none") {
+        // The style (a proxy over the painted scalp, when the base head has one): women's longer, men's mostly short.
+        const double r = uniform(hairRng, 0.0, 1.0);
+        p.hairStyle = female ? (r < 0.15 ? "short" : r < 0.45 ? "bob" : r < 0.8 ? "long" : "ponytail")
+                             : (r < 0.8 ? "short" : r < 0.9 ? "bob" : r < 0.97 ? "long" : "ponytail");
+    }
     p.hairColour = look.bald ? cv::Vec3d(0, 0, 0) : look.hair;
     p.beard = "none";
     if (!female && chance(hairRng, old || middle ? 0.35 : 0.25)) {
@@ -444,6 +451,15 @@ MakeHumanVisitor makeMakeHumanVisitor(const BaseHead& mh, MeshRenderer& renderer
     setup.target = {0.0, -35.0, 0.0};  // MakeHuman's head is a little taller above the ear hole than the test head
     setup.neck = neckOf(mh, v.truthMesh);
     setup.shirt = look.shirt;
+    // The hair proxy of the drawn style on the person's head, in the hair's colour; without one (a base head made
+    // without hair proxies) the painted scalp is all there is, a short cut.
+    if (const auto style = hairStyleFromString(person.hairStyle); style && *style != HairStyle::None) {
+        HairEstimate hair;
+        hair.style = *style;
+        hair.colour = person.hairColour;
+        if (auto part = placeHairPart(mh, v.truthMesh, hair)) setup.parts.push_back(std::move(*part));
+        else person.hairStyle = "short";
+    }
     photographSyntheticHead(v, mh, earHoleOf(mh, v.truthMesh), renderer, setup);
     out.person = std::move(person);
     return out;

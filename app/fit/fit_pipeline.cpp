@@ -1,6 +1,7 @@
 // The photo-to-head pipeline: steps, timings, which photo an error is about, cancellation between steps.
 #include "fit/fit_pipeline.h"
 
+#include "fit/parts/hair_part.h"
 #include "fit/parts/part_colours.h"
 
 #include "common/error.h"
@@ -209,6 +210,7 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     });
     out.partColours = measurePartColours(front, out.frontLandmarks);
     out.parts = placeParts(base_, out.fit.mesh, out.texture.texture, out.partColours);
+    if (auto hair = placeHairPart(base_, out.fit.mesh, out.hair)) out.parts.push_back(std::move(*hair));
     // The brows onto the photo's own (which the texture shows where the fit put dlib's brow points): dlib puts them on
     // a brow's upper half, about 1.5 mm over its middle (the FRMDB overlays).
     std::vector<glm::dvec2> browPoints;
