@@ -253,8 +253,9 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out) {
     const cv::Point2d ear = canon(photos.sidePoints.at("ear_hole"));
     const double heightMm = (p[8].y - p[27].y) / mm;
     const double smm = heightMm > 1.0 ? std::abs(chinS.y - nasion.y) / heightMm : mm;  // side pixels per millimetre
-    a.behindHead = rectOf(ear.x - 115.0 * smm, ear.y + 48.0 * smm, ear.x - 65.0 * smm, ear.y + 70.0 * smm);
-    a.downTheBack = rectOf(ear.x - 120.0 * smm, ear.y + 75.0 * smm, ear.x - 70.0 * smm, ear.y + 100.0 * smm);
+    // A ponytail hangs well behind the head (MakeHuman's ponytail01 100-150 mm behind the ear hole).
+    a.behindHead = rectOf(ear.x - 160.0 * smm, ear.y + 48.0 * smm, ear.x - 65.0 * smm, ear.y + 70.0 * smm);
+    a.downTheBack = rectOf(ear.x - 170.0 * smm, ear.y + 75.0 * smm, ear.x - 70.0 * smm, ear.y + 100.0 * smm);
     a.frontHair = hairJoinedToCrown(a.frontLab, photos.frontMask, a.crown, a, mm);
     a.sideHair = hairJoinedToCrown(a.sideLab, a.sideMask, sideCrown(a.sideMask, ear, smm), a, smm);
 

@@ -39,8 +39,8 @@ struct HairEvidence {
     double hairFromSkin = 0.0;
     double besideFace = 0.0;       // front: beside the jaw, from the nose's base to the lower lip
     double belowChin = 0.0;        // front: beside the neck, 10-45 mm under the chin
-    double behindHead = 0.0;       // side: behind the ear, from 10 to 50 mm under the ear hole
-    double downTheBack = 0.0;      // side: behind the neck, 60-110 mm under the ear hole
+    double behindHead = 0.0;       // side: 65-160 mm behind the ear hole, 48-70 mm under it
+    double downTheBack = 0.0;      // side: 70-170 mm behind the ear hole, 75-100 mm under it
     double chinDarkening = 0.0;    // skin lightness (CIE L*) of the upper cheeks minus the chin's
     double upperLipDarkening = 0.0;  // likewise, the upper lip's
     double jawDarkening = 0.0;     // likewise, the jaw's beside the mouth (the darker side... the lighter of the two)
