@@ -453,7 +453,9 @@ MakeHumanVisitor makeMakeHumanVisitor(const BaseHead& mh, MeshRenderer& renderer
     setup.shirt = look.shirt;
     // The hair proxy of the drawn style on the person's head, in the hair's colour; without one (a base head made
     // without hair proxies) the painted scalp is all there is, a short cut.
-    if (const auto style = hairStyleFromString(person.hairStyle); style && *style != HairStyle::None) {
+    if (const auto style = hairStyleFromString(person.hairStyle); !options.hairProxies) {
+        if (person.hairStyle != "none") person.hairStyle = "short";
+    } else if (style && *style != HairStyle::None) {
         HairEstimate hair;
         hair.style = *style;
         hair.colour = person.hairColour;

@@ -51,6 +51,7 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
         MakeHumanVisitorOptions options;
         options.seed = seed;
         options.sideNoseImageRight = seed % 2 == 0;
+        options.hairProxies = true;
         const MakeHumanVisitor v = makeMakeHumanVisitor(*base, renderer, options);
         const MakeHumanPerson& p = v.person;
         HairPhotos photos;
