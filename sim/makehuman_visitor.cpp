@@ -7,6 +7,7 @@
 #include "common/landmark_names.h"
 #include "fit/face/profile.h"
 #include "fit/head/surface_texels.h"
+#include "fit/parts/hair_part.h"
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
@@ -106,6 +107,8 @@ const Colour& pickColour(Rng& rng, const std::vector<HairColour>& colours, int e
 struct Look {
     cv::Vec3d hair{0, 0, 0}, brow{0, 0, 0}, iris{0, 0, 0};
     bool bald = false, balding = false;
+    bool moustache = false, beard = false;  // painted: the upper lip; the chin and jaw
+    cv::Vec3d beardColour{0, 0, 0};
     double hairlineFront = 108.0;  // height of the hairline over the forehead (head space, mm)
     double nape = -45.0;           // height of the hairline at the back
     double browWidth = 3.0;        // half-thickness of a brow stroke, mm
@@ -204,6 +207,25 @@ std::pair<MakeHumanPerson, Look> draw(const ModifierBasis& basis, unsigned seed)
     p.eyes = iris.name;
     p.irisBgr = look.iris;
     p.browBgr = look.brow;
+
+    // --- Issue 22's hair and beard, from a generator of their own, so that the people drawn before stay the same.
+    Rng hairRng(seed * 40503u + 977u);
+    p.hairStyle = look.bald || look.balding ? "none" : "short";
+    if (p.hairStyle != "none") {
+        // The style (a proxy over the painted scalp, when the base head has one): women's longer, men's mostly short.
+        const double r = uniform(hairRng, 0.0, 1.0);
+        p.hairStyle = female ? (r < 0.15 ? "short" : r < 0.45 ? "bob" : r < 0.8 ? "long" : "ponytail")
+                             : (r < 0.8 ? "short" : r < 0.9 ? "bob" : r < 0.97 ? "long" : "ponytail");
+    }
+    p.hairColour = look.bald ? cv::Vec3d(0, 0, 0) : look.hair;
+    p.beard = "none";
+    if (!female && chance(hairRng, old || middle ? 0.35 : 0.25)) {
+        look.moustache = true;
+        look.beard = chance(hairRng, 0.65);
+        p.beard = look.beard ? "full" : "moustache";
+        // A beard of the hair's colour, a little darker (grey beards stay grey); the bald take a dark brown one.
+        look.beardColour = look.bald ? cv::Vec3d(30, 40, 56) : look.hair * 0.85;
+    }
     return {std::move(p), look};
 }
 
@@ -266,6 +288,29 @@ cv::Mat paintMakeHumanTexture(const BaseHead& base, const cv::Mat& skin, const L
         return earVertex[tri.x] && earVertex[tri.y] && earVertex[tri.z];
     };
 
+    // The beard's and moustache's regions, by the base head's landmarks (front view x, y): the moustache between the
+    // nose's base and the upper lip, the beard from the mouth's corners down over the chin to the throat, in front of
+    // the ears; the lips themselves stay bare.
+    const auto feature = [&](int k) { return mesh.positions[base.frontFeatures.at(landmarkName(k))]; };
+    std::vector<cv::Point2f> lips;
+    for (int k = 48; k <= 59; ++k) lips.emplace_back(static_cast<float>(feature(k).x), static_cast<float>(feature(k).y));
+    const double noseBaseY = feature(33).y, upperLipY = feature(51).y, mouthY = 0.5 * (feature(48).y + feature(54).y);
+    const double mouthHalfWidth = 0.5 * std::abs(feature(54).x - feature(48).x);
+    const double throatY = mesh.positions[base.sideFeatures.at("throat")].y;
+    const double jawZ = 0.5 * (feature(4).z + feature(5).z);  // the beard's back edge, before the ears
+    const auto beardAlpha = [&](const glm::dvec3& p) {
+        const double lipDistance = cv::pointPolygonTest(lips, cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)), true);
+        if (lipDistance > -1.0) return 0.0;  // on the lips or their rim
+        double a = 0.0;
+        if (look.moustache && p.z > 0.0)
+            a = std::max(a, (1.0 - smoothstep(noseBaseY - 3.0, noseBaseY, p.y)) * smoothstep(upperLipY - 2.0, upperLipY + 2.0, p.y) *
+                                (1.0 - smoothstep(mouthHalfWidth + 2.0, mouthHalfWidth + 8.0, std::abs(p.x))));
+        if (look.beard)
+            a = std::max(a, (1.0 - smoothstep(mouthY - 4.0, mouthY + 4.0, p.y)) * smoothstep(throatY - 6.0, throatY + 6.0, p.y) *
+                                smoothstep(jawZ - 25.0, jawZ - 10.0, p.z));
+        return a;
+    };
+
     std::array<glm::dvec2, 10> brow{};
     double browZ = 0.0;
     for (int k = 17; k <= 26; ++k) {
@@ -316,6 +361,11 @@ cv::Mat paintMakeHumanTexture(const BaseHead& base, const cv::Mat& skin, const L
                         }
                     const double alpha = 0.85 * (1.0 - smoothstep(0.7, 1.15, best));
                     if (alpha > 0.0) colour = mix(colour, look.brow * (1.0 + 0.12 * grain(rng)), alpha);
+                }
+                // Beard and moustache: dense short hair over the skin, with a grain.
+                if (look.moustache) {
+                    const double alpha = 0.9 * beardAlpha(p);
+                    if (alpha > 0.0) colour = mix(colour, look.beardColour * (0.9 + 0.15 * grain(rng)), alpha);
                 }
                 // Hair above the hairline, a soft edge a few millimetres wide.
                 if (!look.bald) {
@@ -402,6 +452,17 @@ MakeHumanVisitor makeMakeHumanVisitor(const BaseHead& mh, MeshRenderer& renderer
     setup.target = {0.0, -35.0, 0.0};  // MakeHuman's head is a little taller above the ear hole than the test head
     setup.neck = neckOf(mh, v.truthMesh);
     setup.shirt = look.shirt;
+    // The hair proxy of the drawn style on the person's head, in the hair's colour; without one (a base head made
+    // without hair proxies) the painted scalp is all there is, a short cut.
+    if (const auto style = hairStyleFromString(person.hairStyle); !options.hairProxies) {
+        if (person.hairStyle != "none") person.hairStyle = "short";
+    } else if (style && *style != HairStyle::None) {
+        HairEstimate hair;
+        hair.style = *style;
+        hair.colour = person.hairColour;
+        if (auto part = placeHairPart(mh, v.truthMesh, hair)) setup.parts.push_back(std::move(*part));
+        else person.hairStyle = "short";
+    }
     photographSyntheticHead(v, mh, earHoleOf(mh, v.truthMesh), renderer, setup);
     out.person = std::move(person);
     return out;
@@ -417,6 +478,9 @@ void writeMakeHumanVisitorFolder(const MakeHumanVisitor& v, const BaseHead& mh, 
     j["skin"] = p.skin;
     j["hair"] = p.hair;
     j["eyes"] = p.eyes;
+    j["hair_style"] = p.hairStyle;
+    j["hair_colour_bgr"] = {p.hairColour[0], p.hairColour[1], p.hairColour[2]};
+    j["beard"] = p.beard;
     j["modifiers"] = nlohmann::json::object();
     for (std::size_t k = 0; k < p.weights.size() && mh.modifiers && k < mh.modifiers->modifiers.size(); ++k)
         if (p.weights[k] != 0.0) j["modifiers"][mh.modifiers->modifiers[k].name] = p.weights[k];

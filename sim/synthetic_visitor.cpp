@@ -239,7 +239,13 @@ void photographSyntheticHead(SyntheticVisitor& v, const BaseHead& base, const gl
     v.frontCamera.background = v.sideCamera.background = cv::Scalar(0, 0, 0);
     v.frontCamera.lit = v.sideCamera.lit = setup.lit;
 
-    renderer.upload(v.truthMesh, v.texture);
+    if (setup.parts.empty()) {
+        renderer.upload(v.truthMesh, v.texture);
+    } else {
+        std::vector<AvatarPart> parts{AvatarPart{"head", v.truthMesh, v.texture, AlphaMode::Opaque, 0.5}};
+        parts.insert(parts.end(), setup.parts.begin(), setup.parts.end());
+        renderer.upload(parts);
+    }
     v.background = makeBackdrop(setup.imageSize, setup.backdropSeed);
     v.front = composite(v.background, renderer.render(v.frontCamera), v.frontCamera, false, setup);
     v.side = composite(v.background, renderer.render(v.sideCamera), v.sideCamera, true, setup);

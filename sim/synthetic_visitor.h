@@ -11,6 +11,7 @@
 
 #include "fit/head/base_head.h"
 #include "fit/head/mesh.h"
+#include "fit/parts/avatar_part.h"
 #include "render/mesh_renderer.h"
 
 #include <opencv2/core.hpp>
@@ -18,6 +19,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace avatarbooth {
 
@@ -65,6 +67,8 @@ struct SyntheticPhotoSetup {
     glm::dvec3 target{0.0, -45.0, 0.0};  // at the image centre: the head in the upper middle, shoulders below
     SyntheticNeck neck;
     cv::Scalar shirt{96, 110, 40};       // BGR
+    // Drawn with the head (the hair proxy on the person's head), in head space.
+    std::vector<AvatarPart> parts;
 };
 
 // Renders v.truthMesh with v.texture from the front and the side, composites both on the backdrop (v.front, v.side,

@@ -1,6 +1,7 @@
 // The photo-to-head pipeline: steps, timings, which photo an error is about, cancellation between steps.
 #include "fit/fit_pipeline.h"
 
+#include "fit/parts/hair_part.h"
 #include "fit/parts/part_colours.h"
 
 #include "common/error.h"
@@ -18,6 +19,10 @@ namespace avatarbooth {
 namespace fs = std::filesystem;
 
 namespace {
+
+// Under big hair, how far outside the shaped head an outline crossing on hair may lie and still count: about what
+// short hair adds to the skull's outline.
+constexpr double kBigHairOutlineSlackMm = 15.0;
 
 using Clock = std::chrono::steady_clock;
 
@@ -179,7 +184,24 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     m.sidePoints = out.sideLandmarks;
     m.sideMask = out.sideMask;
     m.sideNoseImageRight = out.sideNoseImageRight;
-    out.fit = runStep(out, control, FitStep::HeadFit, names, [&] { return fitHead(base_, m, settings_.head); });
+    out.fit = runStep(out, control, FitStep::HeadFit, names, [&] {
+        // The hair first: with big hair the outline above and behind the face is the hair's, not the skull's.
+        HeadFitOptions head = settings_.head;
+        try {
+            HairPhotos hp{front, out.frontMask, out.frontLandmarks.points, side, out.sideMask, out.sideLandmarks,
+                          out.sideNoseImageRight};
+            out.hair = estimateHair(hp);
+            if (isBigHair(out.hair.style)) {
+                m.frontHair = hairPixels(front, out.frontMask, out.hair);
+                m.sideHair = hairPixels(side, out.sideMask, out.hair);
+                if (head.hairOutlineSlackMm <= 0.0) head.hairOutlineSlackMm = kBigHairOutlineSlackMm;
+            }
+        } catch (const std::exception& e) {  // no hair is better than no avatar
+            out.hair = HairEstimate{};
+            out.warnings.push_back(std::string("hair analysis: ") + e.what());
+        }
+        return fitHead(base_, m, head);
+    });
     for (const auto& w : out.fit.warnings) out.warnings.push_back(w);
     for (const auto* features : {&base_.frontFeatures, &base_.sideFeatures})
         for (const auto& [name, v] : *features) out.featurePoints.emplace_back(name, out.fit.mesh.positions[v]);
@@ -189,6 +211,7 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     });
     out.partColours = measurePartColours(front, out.frontLandmarks);
     out.parts = placeParts(base_, out.fit.mesh, out.texture.texture, out.partColours);
+    if (auto hair = placeHairPart(base_, out.fit.mesh, out.hair)) out.parts.push_back(std::move(*hair));
     // The brows onto the photo's own (which the texture shows where the fit put dlib's brow points): dlib puts them on
     // a brow's upper half, about 1.5 mm over its middle (the FRMDB overlays).
     std::vector<glm::dvec2> browPoints;

@@ -3,6 +3,7 @@
 // folder is booth/session_folder.h's; the character is made from the outcome by reveal/character.
 #pragma once
 
+#include "fit/face/hair_analysis.h"
 #include "fit/face/landmarks68.h"
 #include "fit/face/profile.h"
 #include "fit/fit_error.h"
@@ -53,6 +54,7 @@ struct FitOutcome {
     std::map<std::string, cv::Point2d> sideLandmarks;
     bool sideNoseImageRight = true;
     cv::Mat sideMask;
+    HairEstimate hair;  // the hair style, its colour, beard and moustache (fit/face/hair_analysis.h)
     HeadFit fit;
     PhotoTexture texture;
     // The avatar as shown and exported (fit/parts/avatar_part.h): the head (fit.mesh without what the proxies

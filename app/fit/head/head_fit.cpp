@@ -255,8 +255,17 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     // both photos show (least squares y = a v + b): top of head, nasion, nose tip, subnasale, upper lip.
     const bool mirror = !photos.sideNoseImageRight;
     const int sideWidth = photos.sideMask.cols;
-    cv::Mat sideMask;
+    cv::Mat sideMask, sideHair;
     if (mirror) cv::flip(photos.sideMask, sideMask, 1); else sideMask = photos.sideMask;
+    if (mirror && !photos.sideHair.empty()) cv::flip(photos.sideHair, sideHair, 1); else sideHair = photos.sideHair;
+    // A crossing on hair (the pixel just inside it) farther than the slack outside where the shaped head's vertex
+    // projects measures the hair, not the skull.
+    const auto onBigHair = [&](const cv::Mat& hair, const cv::Point2d& hit, const cv::Point2d& vertexPx, const cv::Point2d& from,
+                               double mmPerPixel) {
+        if (options.hairOutlineSlackMm <= 0.0 || hair.empty()) return false;
+        const cv::Point2d in = hit + (from - hit) * (2.0 / std::max(1.0, cv::norm(from - hit)));
+        return inMask(hair, in) && cv::norm(hit - from) - cv::norm(vertexPx - from) > options.hairOutlineSlackMm / mmPerPixel;
+    };
     const auto side = [&](const std::string& name) { return mirrorPoint(need(photos.sidePoints, name, "side"), sideWidth, mirror); };
     const std::pair<const char*, glm::dvec2> ties[] = {
         {"top_of_head", frontRel(topPx)},          {"nasion", frontRel(fp.at(landmarkName(27)))},
@@ -375,12 +384,17 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
                 const auto onJaw = polylineCrossing(jawLine, eyeMidPx, dir);
                 if (!onJaw || cv::norm(hit - eyeMidPx) > kOutlineBeyondJaw * cv::norm(*onJaw - eyeMidPx)) continue;
             }
+            if (onBigHair(photos.frontHair, hit, fit.front.toPixel({p.x, p.y}), eyeMidPx, fit.front.mmPerPixel)) continue;
             fit.frontRays.emplace_back(eyeMidPx, hit);
             addFrontContour("front_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, fit.front.toHead(hit));
         }
         for (const auto& [name, v] : base.sideFeatures) {
             const auto it = photos.sidePoints.find(name);
             if (it == photos.sidePoints.end()) continue;
+            const cv::Point2d at = mirrorPoint(it->second, sideWidth, mirror);
+            if (onBigHair(sideHair, at, sideCanonical.toPixel(projectToView(scaled.positions[v], View::Side)), earPx,
+                          sideCanonical.mmPerPixel))
+                continue;
             sideT.add(scaled, name, v, sideCanonical.toHead(mirrorPoint(it->second, sideWidth, mirror)),
                       onSmoothOutline(name) ? &scaledNormals : nullptr);
         }
@@ -390,6 +404,8 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
             const glm::dvec2 earHead = sideCanonical.toHead(earCanonical);
             const cv::Point2d dir(p.z - earHead.x, -(p.y - earHead.y));
             const cv::Point2d hit = outlineCrossing(sideMask, earCanonical, dir, "side");
+            if (onBigHair(sideHair, hit, sideCanonical.toPixel(projectToView(p, View::Side)), earCanonical, sideCanonical.mmPerPixel))
+                continue;
             fit.sideRays.emplace_back(mirrorPoint(earCanonical, sideWidth, mirror), mirrorPoint(hit, sideWidth, mirror));
             addSideContour("side_contour_" + std::to_string(static_cast<int>(cv.angleDeg)), cv.vertex, sideCanonical.toHead(hit));
         }

@@ -21,6 +21,8 @@ struct PhotoMeasurements {
     std::map<std::string, cv::Point2d> sidePoints;   // profile landmarks (nose_tip, ...), in the side photo as taken
     cv::Mat sideMask;                                 // CV_8U silhouette in the side photo as taken
     bool sideNoseImageRight = true;                   // false: the side photo is mirrored before use
+    // Hair pixels of each photo as taken (CV_8U, 255 on hair; empty: not known), for hairOutlineSlackMm.
+    cv::Mat frontHair, sideHair;
 };
 
 struct HeadFitOptions {
@@ -49,6 +51,11 @@ struct HeadFitOptions {
     bool faceProfile = true;
     double faceProfileWeight = 0.3;
     double faceProfileSearchMm = 12.0;
+    // Big hair (a bob, long hair, a bun): an outline ray or a profile point that ends on hair (the photos' hair
+    // masks) more than this far outside the shaped head measures the hair, not the skull, and is left out, so that
+    // the skull stays where the modifiers put it under a separate hair part. 0: every crossing counts (the hair
+    // analysis sets it when the hair is big).
+    double hairOutlineSlackMm = 0.0;
 };
 
 HeadFitOptions defaultHeadFitOptions();

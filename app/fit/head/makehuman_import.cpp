@@ -741,6 +741,16 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
         lashes.alphaCutoff = 0.3;
         head.proxies.push_back(std::move(lashes));
     }
+    for (const std::string& style : options.hair) {
+        // Strand cards with alpha: kept where the alpha is at least half (no sorting among thousands of cards); the
+        // visitor's colour on every strand.
+        HeadProxy hair = bindProxy("hair", style, "hair").first;
+        hair.alpha = AlphaMode::Mask;
+        hair.alphaCutoff = 0.5;
+        cv::extractChannel(hair.texture, hair.tintMask, 3);
+        cv::threshold(hair.tintMask, hair.tintMask, 8, 255, cv::THRESH_BINARY);
+        head.proxies.push_back(std::move(hair));
+    }
     head.sideContour = findContourVertices(mesh, head.earHoleCentre, 1, defaultSideContourAngles());
 
     // --- The modifier basis, on the head's vertices (millimetres). The macro directions move the whole body; their

@@ -2,6 +2,7 @@
 #include "fit/parts/avatar_parts.h"
 
 #include "common/error.h"
+#include "fit/parts/hair_part.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -134,6 +135,7 @@ std::vector<AvatarPart> placeParts(const BaseHead& base, const Mesh& fittedHead,
     head.texture = headTexture;
     parts.push_back(std::move(head));
     for (const HeadProxy& p : base.proxies) {
+        if (isHairStyleProxy(p)) continue;  // alternatives: the fit places the one it chose (hair_part.h)
         const auto c = colours.find(p.name);
         parts.push_back(placeProxyPart(p, fittedHead, c == colours.end() ? nullptr : &c->second));
     }

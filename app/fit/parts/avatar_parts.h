@@ -20,7 +20,8 @@ using PartColours = std::map<std::string, cv::Vec3d>;
 
 // The head (named "head": `fittedHead` without the triangles the proxies replace, with `headTexture`), then each of
 // `base.proxies` placed on `fittedHead` (which has the base head's topology), tinted where it has a tint mask and
-// `colours` has its name.
+// `colours` has its name. The hair styles are left out: they are alternatives, and the fit places the one it chose
+// (hair_part.h).
 std::vector<AvatarPart> placeParts(const BaseHead& base, const Mesh& fittedHead, const cv::Mat& headTexture,
                                    const PartColours& colours = {});
 

@@ -83,13 +83,16 @@ std::string saveHeadProxy(const HeadProxy& p, const fs::path& dir) {
     auto& triangles = j["triangles"] = nlohmann::json::array();
     for (const auto& t : p.mesh.triangles) triangles.push_back({t.x, t.y, t.z});
     j["replaces"] = p.replaces;
-    j["texture"] = p.name + ".png";
-    writeFileAtomically(dir / (p.name + ".png"), encodeImage(p.texture, ".png"));
+    // Named by the part and, when several proxies make the same part (the hair styles), by the source's folder too.
+    const std::string leaf = fs::path(p.source).filename().string();
+    const std::string stem = leaf.empty() || leaf == p.name ? p.name : p.name + "_" + leaf;
+    j["texture"] = stem + ".png";
+    writeFileAtomically(dir / (stem + ".png"), encodeImage(p.texture, ".png"));
     if (!p.tintMask.empty()) {
-        j["tint_mask"] = p.name + ".tint.png";
-        writeFileAtomically(dir / (p.name + ".tint.png"), encodeImage(p.tintMask, ".png"));
+        j["tint_mask"] = stem + ".tint.png";
+        writeFileAtomically(dir / (stem + ".tint.png"), encodeImage(p.tintMask, ".png"));
     }
-    const std::string file = p.name + ".json";
+    const std::string file = stem + ".json";
     writeFileAtomically(dir / file, j.dump() + "\n");
     return file;
 }

@@ -49,7 +49,8 @@ struct HeadProxy {
 };
 
 // Writes NAME.json (binding, triangles, UVs, alpha, replaced vertices), NAME.png (texture) and, when there is one,
-// NAME.tint.png into `dir`; returns NAME.json's file name.
+// NAME.tint.png into `dir`, NAME being the part's name and the source's folder (eyes_HighPolyEyes; several
+// proxies make the same part: the hair styles); returns NAME.json's file name.
 std::string saveHeadProxy(const HeadProxy& proxy, const std::filesystem::path& dir);
 // Reads what saveHeadProxy wrote and places it on `head` (the base head's positions; the binding must refer to them).
 // Throws BoothError(BadConfig) naming the file and the field.

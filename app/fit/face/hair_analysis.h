@@ -1,0 +1,98 @@
+// Hair and beard from the two photos (issue 22): which of the bundled hair styles the visitor wears, read from
+// where hair-coloured pixels lie in the two silhouettes around the face, the hair's colour, and whether a beard or
+// moustache shows. Photos, silhouettes and landmarks in; a plain HairEstimate out.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace avatarbooth {
+
+// The hair styles the avatar can wear (one bundled MakeHuman proxy each; None: bald, no hair part).
+enum class HairStyle { None, Short, Bob, Long, Ponytail };
+
+inline constexpr std::array<HairStyle, 5> kHairStyles{HairStyle::None, HairStyle::Short, HairStyle::Bob, HairStyle::Long,
+                                                     HairStyle::Ponytail};
+
+constexpr const char* toString(HairStyle style) {
+    switch (style) {
+        case HairStyle::None: return "none";
+        case HairStyle::Short: return "short";
+        case HairStyle::Bob: return "bob";
+        case HairStyle::Long: return "long";
+        case HairStyle::Ponytail: return "ponytail";
+    }
+    return "none";
+}
+std::optional<HairStyle> hairStyleFromString(std::string_view name);
+
+// What the estimate was read from: the share of hair-coloured pixels in each window (0..1), for fit.json and tests.
+struct HairEvidence {
+    double crown = 0.0;            // front: a band 20 mm deep under the head's top, over the face's width
+    // The crown's unlike-skin pixels' median against the skin's (labDistance units). Not used: a bald scalp in the
+    // top light (15-30) and blond or light brown hair on pale skin (14-26) overlap on the synthetic people.
+    double hairFromSkin = 0.0;
+    double besideFace = 0.0;       // front: beside the jaw, from the nose's base to the lower lip
+    double belowChin = 0.0;        // front: beside the neck, 10-45 mm under the chin
+    double behindHead = 0.0;       // side: 65-160 mm behind the ear hole, 48-70 mm under it
+    double downTheBack = 0.0;      // side: 70-170 mm behind the ear hole, 75-100 mm under it
+    double chinDarkening = 0.0;    // skin lightness (CIE L*) of the upper cheeks minus the chin's
+    double upperLipDarkening = 0.0;  // likewise, the upper lip's
+    double jawDarkening = 0.0;     // likewise, the jaw's beside the mouth (the darker side... the lighter of the two)
+};
+
+struct HairEstimate {
+    HairStyle style = HairStyle::None;
+    cv::Vec3d colour{0.0, 0.0, 0.0};        // BGR 0..255: the median hair pixel (the crown's), when there is hair
+    bool beard = false;                     // chin and jaw darker than the cheeks
+    bool moustache = false;                 // the upper lip darker than the cheeks
+    cv::Vec3d beardColour{0.0, 0.0, 0.0};   // BGR, the chin's (or the upper lip's) median, when either
+    cv::Vec3d skinColour{0.0, 0.0, 0.0};    // BGR, the upper cheeks' median
+    cv::Vec3d hairLab{0.0, 0.0, 0.0}, skinLab{0.0, 0.0, 0.0};  // the two colour models (CIE L*a*b*, medians)
+    HairEvidence evidence;
+};
+
+// The photos as the fit has them: the front with dlib's 68 points (iBUG order), the side with the profile
+// landmarks (at least nasion, chin and ear_hole; fit/face/profile.h), both with their person masks (CV_8U, 255 on
+// the person), pixels as taken (the side may face either way).
+struct HairPhotos {
+    cv::Mat front, frontMask;
+    std::array<cv::Point2d, 68> frontPoints{};
+    cv::Mat side, sideMask;
+    std::map<std::string, cv::Point2d> sidePoints;
+    bool sideNoseImageRight = true;
+};
+
+// Thresholds of the choice (hair_analysis.cpp says how they were set).
+struct HairOptions {
+    double bald = 0.3;           // crown share under this: no hair
+    double long_ = 0.15;         // belowChin over this: the hair falls past the chin beside the neck
+    double beside = 0.2;         // besideFace over this (not long): a bob
+    double ponytail = 0.3;       // downTheBack and behindHead over this (nothing beside the face or neck): a ponytail
+    double beardDarkening = 14.0;   // chin (and jaw at 0.5 of it) L* under the cheeks' by this much: a beard
+    double moustacheDarkening = 16.0;  // the upper lip's (shaded by the nose even when bare): a moustache
+};
+
+// Throws BoothError(BadInput) when a photo or mask is empty, not BGR / CV_8U, or of another size than its photo,
+// or a needed side landmark is missing.
+HairEstimate estimateHair(const HairPhotos& photos, const HairOptions& options = {});
+
+// The hair pixels of a photo (CV_8U, 255 on hair) inside its person mask, by the estimate's colour models: nearer
+// the hair's colour than the skin's. All 0 when the estimate found no hair.
+cv::Mat hairPixels(const cv::Mat& bgr, const cv::Mat& personMask, const HairEstimate& estimate);
+
+// Whether a style stands out from the skull enough that the head fit should not follow its outline (a bob, long
+// hair, a ponytail's knot): HeadFitOptions::hairOutlineSlackMm is set for these.
+constexpr bool isBigHair(HairStyle style) {
+    return style == HairStyle::Bob || style == HairStyle::Long || style == HairStyle::Ponytail;
+}
+
+// The windows estimateHair reads, drawn on a copy of each photo (hair pixels tinted), for a person to check.
+std::pair<cv::Mat, cv::Mat> drawHairOverlay(const HairPhotos& photos, const HairEstimate& estimate);
+
+}  // namespace avatarbooth

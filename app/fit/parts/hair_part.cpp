@@ -1,0 +1,38 @@
+// The hair part (hair_part.h).
+#include "fit/parts/hair_part.h"
+
+#include "fit/parts/avatar_parts.h"
+
+#include <string>
+
+namespace avatarbooth {
+
+const char* hairProxyName(HairStyle style) {
+    switch (style) {
+        case HairStyle::None: return nullptr;
+        case HairStyle::Short: return "short02";
+        case HairStyle::Bob: return "bob02";
+        case HairStyle::Long: return "long01";
+        case HairStyle::Ponytail: return "ponytail01";
+    }
+    return nullptr;
+}
+
+bool isHairStyleProxy(const HeadProxy& proxy) { return proxy.name == "hair"; }
+
+const HeadProxy* findHairProxy(const BaseHead& base, HairStyle style) {
+    const char* name = hairProxyName(style);
+    if (name == nullptr) return nullptr;
+    const std::string source = std::string("proxies/hair/") + name;
+    for (const HeadProxy& p : base.proxies)
+        if (isHairStyleProxy(p) && p.source == source) return &p;
+    return nullptr;
+}
+
+std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fittedHead, const HairEstimate& hair) {
+    const HeadProxy* proxy = findHairProxy(base, hair.style);
+    if (proxy == nullptr) return std::nullopt;
+    return placeProxyPart(*proxy, fittedHead, &hair.colour);
+}
+
+}  // namespace avatarbooth

@@ -1,0 +1,125 @@
+// The hair analysis against synthetic MakeHuman people whose hair and beard are known (sim/makehuman_visitor.h): a
+// seeded set, each photographed front and side, analysed as the booth does (dlib's landmarks, the silhouettes, the
+// profile points) and the estimate compared with the truth. Prints the confusion table; asserts what held with
+// margin when it was written. Needs the product's base head; skips when it is absent.
+#include "test_paths.h"
+
+#include "common/error.h"
+#include "fit/face/hair_analysis.h"
+#include "fit/fit_pipeline.h"
+#include "sim/makehuman_visitor.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace avatarbooth;
+
+namespace {
+
+constexpr unsigned kPeople = 36;
+
+// CIE76 colour difference of two BGR colours (0..255).
+double deltaE(const cv::Vec3d& a, const cv::Vec3d& b) {
+    cv::Mat m(1, 2, CV_32FC3);
+    m.at<cv::Vec3f>(0, 0) = cv::Vec3f(a / 255.0);
+    m.at<cv::Vec3f>(0, 1) = cv::Vec3f(b / 255.0);
+    cv::cvtColor(m, m, cv::COLOR_BGR2Lab);
+    return cv::norm(m.at<cv::Vec3f>(0, 0) - m.at<cv::Vec3f>(0, 1));
+}
+
+}  // namespace
+
+TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
+    if (findMakeHumanBaseHead().empty()) GTEST_SKIP() << "the MakeHuman base head was not built";
+    const auto base = productBaseHead();
+    const FitPipeline pipeline{FitSettings{}, *base};
+    MeshRenderer renderer;
+    std::map<std::string, std::map<std::string, int>> confusion;  // truth -> estimate -> count
+    int styleRight = 0, beardRight = 0, moustacheRight = 0, withHair = 0, refused = 0;
+    std::vector<double> colourErrors;
+    const fs::path out = test::scratchDir("hair_population");
+    for (unsigned seed = 1; seed <= kPeople; ++seed) {
+        MakeHumanVisitorOptions options;
+        options.seed = seed;
+        options.sideNoseImageRight = seed % 2 == 0;
+        options.hairProxies = true;
+        const MakeHumanVisitor v = makeMakeHumanVisitor(*base, renderer, options);
+        const MakeHumanPerson& p = v.person;
+        HairPhotos photos;
+        try {
+        photos.front = v.photos.front;
+        photos.side = v.photos.side;
+        const FrontAnalysis front = pipeline.analyseFront(v.photos.front, v.photos.background);
+        photos.frontMask = front.mask;
+        photos.frontPoints = front.landmarks.points;
+        const SideAnalysis side = analyseSidePhoto(v.photos.side, v.photos.background);
+        photos.sideMask = side.mask;
+        photos.sideNoseImageRight = side.noseImageRight;
+        for (const auto& q : side.landmarks) photos.sidePoints[q.name] = q.px;
+        } catch (const BoothError& err) {
+            // The booth refuses such photos; the hair analysis never sees them.
+            ++refused;
+            cv::imwrite((out / ("seed" + std::to_string(seed) + "_refused_side.jpg")).string(), v.photos.side);
+            std::printf("%3u %-6s %-9s %-20s refused: %s\n", seed, p.sex.c_str(), p.hairStyle.c_str(), p.hair.c_str(), err.what());
+            continue;
+        }
+        const HairEstimate e = estimateHair(photos);
+        const auto [f, s] = drawHairOverlay(photos, e);
+        cv::imwrite((out / ("seed" + std::to_string(seed) + "_front.jpg")).string(), f);
+        cv::imwrite((out / ("seed" + std::to_string(seed) + "_side.jpg")).string(), s);
+
+        ++confusion[p.hairStyle][toString(e.style)];
+        styleRight += p.hairStyle == toString(e.style);
+        const bool beard = p.beard == "full", moustache = p.beard != "none";
+        beardRight += e.beard == beard;
+        moustacheRight += e.moustache == moustache;
+        double dE = 0.0;
+        if (p.hairStyle != "none" && e.style != HairStyle::None) {
+            ++withHair;
+            dE = deltaE(e.colour, p.hairColour);
+            colourErrors.push_back(dE);
+        }
+        const HairEvidence& x = e.evidence;
+        std::printf("%3u %-6s %-9s %-20s -> %-8s | crown %.2f (%4.1f) beside %.2f below %.2f behind %.2f back %.2f | beard %-9s chin %5.1f "
+                    "lip %5.1f jaw %5.1f -> %s%s | dE %.1f\n",
+                    seed, p.sex.c_str(), p.hairStyle.c_str(), p.hair.c_str(), toString(e.style), x.crown, x.hairFromSkin, x.besideFace,
+                    x.belowChin, x.behindHead, x.downTheBack, p.beard.c_str(), x.chinDarkening, x.upperLipDarkening,
+                    x.jawDarkening, e.beard ? "beard" : "-", e.moustache ? "+moustache" : "", dE);
+    }
+    std::printf("\nconfusion (rows: truth, columns: estimate)\n%-9s", "");
+    for (const HairStyle s : kHairStyles) std::printf(" %8s", toString(s));
+    std::printf("\n");
+    for (const auto& [truth, row] : confusion) {
+        std::printf("%-9s", truth.c_str());
+        for (const HairStyle s : kHairStyles) {
+            const auto it = row.find(toString(s));
+            std::printf(" %8d", it == row.end() ? 0 : it->second);
+        }
+        std::printf("\n");
+    }
+    std::sort(colourErrors.begin(), colourErrors.end());
+    const double medianDe = colourErrors.empty() ? 0.0 : colourErrors[colourErrors.size() / 2];
+    std::printf("refused by the photo analysis: %d\n", refused);
+    std::printf("style right %d of %u; beard right %d, moustache right %d of %u; hair colour dE median %.1f, worst %.1f over %d "
+                "people with hair\n",
+                styleRight, kPeople, beardRight, moustacheRight, kPeople, medianDe, colourErrors.empty() ? 0.0 : colourErrors.back(),
+                withHair);
+    // With MakeHuman's hair proxies in the photos, a quarter of the side photos are refused by the profile analysis
+    // (a fringe or a bob over the profile: issue 22's profile work); the rest is what held when this was written.
+    const int analysed = static_cast<int>(kPeople) - refused;
+    EXPECT_LE(refused, 12);
+    EXPECT_GE(styleRight, analysed / 2);
+    EXPECT_GE(beardRight, analysed * 9 / 10);
+    EXPECT_GE(moustacheRight, analysed * 9 / 10);
+    EXPECT_GE(withHair, 18);
+    EXPECT_LT(medianDe, 15.0);
+}
