@@ -4,6 +4,7 @@
 #include "fit/parts/avatar_parts.h"
 
 #include <string>
+#include <vector>
 
 namespace avatarbooth {
 
@@ -32,7 +33,19 @@ const HeadProxy* findHairProxy(const BaseHead& base, HairStyle style) {
 std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fittedHead, const HairEstimate& hair) {
     const HeadProxy* proxy = findHairProxy(base, hair.style);
     if (proxy == nullptr) return std::nullopt;
-    return placeProxyPart(*proxy, fittedHead, &hair.colour);
+    std::optional<AvatarPart> part = placeProxyPart(*proxy, fittedHead, &hair.colour);
+    // The avatar is a bust cut under the chin: long hair ends where the neck does, not in the air at waist height
+    // (which also made every preview frame a head a third of its size).
+    if (part) {
+        glm::dvec3 lo, hi;
+        fittedHead.bounds(lo, hi);
+        std::vector<glm::uvec3> kept;
+        for (const auto& t : part->mesh.triangles)
+            if (part->mesh.positions[t.x].y >= lo.y || part->mesh.positions[t.y].y >= lo.y || part->mesh.positions[t.z].y >= lo.y)
+                kept.push_back(t);
+        part->mesh.triangles = std::move(kept);
+    }
+    return part;
 }
 
 }  // namespace avatarbooth
