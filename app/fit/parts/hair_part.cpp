@@ -3,6 +3,7 @@
 
 #include "fit/parts/avatar_parts.h"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -39,11 +40,22 @@ std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fitted
     if (part) {
         glm::dvec3 lo, hi;
         fittedHead.bounds(lo, hi);
-        std::vector<glm::uvec3> kept;
-        for (const auto& t : part->mesh.triangles)
-            if (part->mesh.positions[t.x].y >= lo.y || part->mesh.positions[t.y].y >= lo.y || part->mesh.positions[t.z].y >= lo.y)
-                kept.push_back(t);
-        part->mesh.triangles = std::move(kept);
+        // Only the vertices the kept triangles use stay (the previews frame a part by its vertices).
+        Mesh& m = part->mesh;
+        Mesh cut;
+        std::vector<std::uint32_t> newIndex(m.positions.size(), UINT32_MAX);
+        const auto keep = [&](std::uint32_t v) {
+            if (newIndex[v] == UINT32_MAX) {
+                newIndex[v] = static_cast<std::uint32_t>(cut.positions.size());
+                cut.positions.push_back(m.positions[v]);
+                if (!m.uvs.empty()) cut.uvs.push_back(m.uvs[v]);
+            }
+            return newIndex[v];
+        };
+        for (const auto& t : m.triangles)
+            if (m.positions[t.x].y >= lo.y || m.positions[t.y].y >= lo.y || m.positions[t.z].y >= lo.y)
+                cut.triangles.emplace_back(keep(t.x), keep(t.y), keep(t.z));
+        m = std::move(cut);
     }
     return part;
 }
