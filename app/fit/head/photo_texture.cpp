@@ -275,7 +275,9 @@ TextureTables::TextureTables(const Mesh& base, const PhotoTextureOptions& option
     layer.convertTo(layer, CV_32FC3);
     cv::Mat smooth;
     cv::GaussianBlur(layer, smooth, cv::Size(), options.size / 80.0);
-    skinDetail_ = layer - smooth;
+    // Held as whole levels in 8 bits (3 MB at 1024 texels instead of 12.6 MB of floats): the detail is added to
+    // 8-bit texels, and a fold's shading lies well within +-127 levels of its surroundings (beyond, it saturates).
+    cv::subtract(layer, smooth, skinDetail_, cv::noArray(), CV_8S);
 }
 
 PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
@@ -396,7 +398,6 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
             long overlapAcc = 0;
             for (int y = half.height * stripe / kStripes; y < half.height * (stripe + 1) / kStripes; ++y) {
                 const int* tri = halfMap.triangle.ptr<int>(y);
-                const cv::Vec2f* bary = halfMap.barycentric.ptr<cv::Vec2f>(y);
                 cv::Vec3f* fc = frontHalf.ptr<cv::Vec3f>(y);
                 cv::Vec3f* sc = sideHalf.ptr<cv::Vec3f>(y);
                 float* fw = frontSeen.ptr<float>(y);
@@ -405,7 +406,8 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
                 unsigned char* src = halfSource.ptr<unsigned char>(y);
                 for (int x = 0; x < half.width; ++x) {
                     if (tri[x] < 0) continue;
-                    const TexelView v = classify(tri[x], bary[x][0], bary[x][1]);
+                    const cv::Vec2d bary = halfMap.barycentric(tri[x], x, y);
+                    const TexelView v = classify(tri[x], static_cast<float>(bary[0]), static_cast<float>(bary[1]));
                     if (v.seenFront) {
                         fc[x] = bilinear(front, v.fu, v.fv);
                         fw[x] = 1.0f;
@@ -495,7 +497,6 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
             int coveredAcc = 0, seenAcc = 0;
             for (int y = size.height * stripe / kStripes; y < size.height * (stripe + 1) / kStripes; ++y) {
                 const int* tri = map.triangle.ptr<int>(y);
-                const cv::Vec2f* bary = map.barycentric.ptr<cv::Vec2f>(y);
                 unsigned char* src = out.source.ptr<unsigned char>(y);
                 cv::Vec3b* o = out.texture.ptr<cv::Vec3b>(y);
                 const cv::Vec3f *f0, *f1, *s0, *s1, *b0, *b1;
@@ -529,7 +530,8 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
                         // A texel takes a photo only where the half-resolution pass saw that photo too: its
                         // correction subtracts that photo's half-resolution colour, which elsewhere is a stand-in
                         // (the other photo's, or the fill), and the difference would show as a step.
-                        const TexelView v = classify(tri[x], bary[x][0], bary[x][1]);
+                        const cv::Vec2d bary = map.barycentric(tri[x], x, y);
+                        const TexelView v = classify(tri[x], static_cast<float>(bary[0]), static_cast<float>(bary[1]));
                         const bool frontThere = v.seenFront && frontSeenRow[hx], sideThere = v.seenSide && sideSeenRow[hx];
                         if (frontThere && (v.frontChosen || !sideThere)) {
                             o[x] = toBgr(bilinear(front, v.fu, v.fv) + upsample.at(f0, f1, fy, x));
@@ -564,6 +566,7 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
 
 void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& detail) {
     if (texture.texture.empty() || detail.empty() || detail.size() != texture.texture.size()) return;
+    if (detail.type() != CV_8SC3) throw BoothError(ErrorKind::Internal, "", "texture: the skin detail must be CV_8SC3");
     // Feathered: the made-up texels take all of it, those a photo saw none, with a soft edge between (the mask
     // blurred at an eighth of the size: the edge needs no more).
     cv::Mat filled, small, weight;
@@ -575,7 +578,7 @@ void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& detail) {
     // One pass, touching only the texels the fill made up (most of the texture was seen and stays as it is).
     for (int y = 0; y < weight.rows; ++y) {
         const float* w = weight.ptr<float>(y);
-        const cv::Vec3f* d = detail.ptr<cv::Vec3f>(y);
+        const cv::Vec<schar, 3>* d = detail.ptr<cv::Vec<schar, 3>>(y);
         cv::Vec3b* t = texture.texture.ptr<cv::Vec3b>(y);
         for (int x = 0; x < weight.cols; ++x) {
             if (w[x] <= 0.0f) continue;

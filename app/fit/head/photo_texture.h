@@ -55,7 +55,7 @@ public:
     const TexelMap& half() const { return half_; }
     // Whether `mesh` has the UV layout the tables were made for (same vertex and triangle counts).
     bool fits(const Mesh& mesh) const { return mesh.uvs.size() == vertices_ && mesh.triangles.size() == triangles_; }
-    // The skin layer's fine detail at the texture's size (CV_32FC3), or empty: see addBaseLayerDetail.
+    // The skin layer's fine detail at the texture's size (CV_8SC3, levels), or empty: see addBaseLayerDetail.
     const cv::Mat& skinDetail() const { return skinDetail_; }
 
 private:

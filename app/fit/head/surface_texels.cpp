@@ -16,7 +16,7 @@ TexelMap mapTexels(const Mesh& mesh, cv::Size size) {
     TexelMap map;
     map.size = size;
     map.triangle = cv::Mat(size, CV_32S, cv::Scalar(-1));
-    map.barycentric = cv::Mat(size, CV_32FC2, cv::Scalar::all(0));
+    map.weights.resize(mesh.triangles.size());
     const double w = size.width, h = size.height;
     for (std::size_t ti = 0; ti < mesh.triangles.size(); ++ti) {
         const auto& t = mesh.triangles[ti];
@@ -25,6 +25,11 @@ TexelMap mapTexels(const Mesh& mesh, cv::Size size) {
         for (int k = 0; k < 3; ++k) p[k] = glm::dvec2(mesh.uvs[idx[k]].x * w, mesh.uvs[idx[k]].y * h);
         const double area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
         if (std::abs(area) < 1e-12) continue;  // degenerate in UV (e.g. at a pole)
+        // The two weights below, b = (k + gx cx + gy cy) / area at the texel centre (cx, cy) = (x + 0.5, y + 0.5).
+        const double k0 = p[1].x * p[2].y - p[2].x * p[1].y, gx0 = p[1].y - p[2].y, gy0 = p[2].x - p[1].x;
+        const double k1 = p[2].x * p[0].y - p[0].x * p[2].y, gx1 = p[2].y - p[0].y, gy1 = p[0].x - p[2].x;
+        map.weights[ti] = {(k0 + 0.5 * (gx0 + gy0)) / area, gx0 / area, gy0 / area,
+                           (k1 + 0.5 * (gx1 + gy1)) / area, gx1 / area, gy1 / area};
         const int x0 = std::max(0, static_cast<int>(std::floor(std::min({p[0].x, p[1].x, p[2].x}))));
         const int x1 = std::min(size.width - 1, static_cast<int>(std::ceil(std::max({p[0].x, p[1].x, p[2].x}))));
         const int y0 = std::max(0, static_cast<int>(std::floor(std::min({p[0].y, p[1].y, p[2].y}))));
@@ -37,7 +42,6 @@ TexelMap mapTexels(const Mesh& mesh, cv::Size size) {
                 constexpr double eps = -1e-9;
                 if (b0 < eps || b1 < eps || 1.0 - b0 - b1 < eps) continue;
                 map.triangle.at<int>(y, x) = static_cast<int>(ti);
-                map.barycentric.at<cv::Vec2f>(y, x) = cv::Vec2f(static_cast<float>(b0), static_cast<float>(b1));
             }
         }
     }
@@ -51,11 +55,11 @@ SurfaceTexels sampleSurfaceTexels(const Mesh& mesh, const std::vector<glm::dvec3
     out.covered = cv::Mat(map.size, CV_8U, cv::Scalar(0));
     for (int y = 0; y < map.size.height; ++y) {
         const int* tri = map.triangle.ptr<int>(y);
-        const cv::Vec2f* bary = map.barycentric.ptr<cv::Vec2f>(y);
         for (int x = 0; x < map.size.width; ++x) {
             if (tri[x] < 0) continue;
             const auto& t = mesh.triangles[static_cast<std::size_t>(tri[x])];
-            const double b0 = bary[x][0], b1 = bary[x][1], b2 = 1.0 - b0 - b1;
+            const cv::Vec2d bary = map.barycentric(tri[x], x, y);
+            const double b0 = bary[0], b1 = bary[1], b2 = 1.0 - b0 - b1;
             const glm::dvec3 pos = b0 * mesh.positions[t.x] + b1 * mesh.positions[t.y] + b2 * mesh.positions[t.z];
             const glm::dvec3 nrm = glm::normalize(b0 * normals[t.x] + b1 * normals[t.y] + b2 * normals[t.z]);
             out.position.at<cv::Vec3f>(y, x) = cv::Vec3f(static_cast<float>(pos.x), static_cast<float>(pos.y), static_cast<float>(pos.z));

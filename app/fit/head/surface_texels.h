@@ -6,6 +6,8 @@
 
 #include <opencv2/core.hpp>
 
+#include <vector>
+
 namespace avatarbooth {
 
 struct SurfaceTexels {
@@ -18,8 +20,18 @@ struct SurfaceTexels {
 // base head and reused for every fitted head of that topology.
 struct TexelMap {
     cv::Size size;
-    cv::Mat triangle;     // CV_32S, index into Mesh::triangles, -1 where no triangle covers the texel
-    cv::Mat barycentric;  // CV_32FC2, weights of the triangle's first two corners (the third is 1 - both)
+    cv::Mat triangle;  // CV_32S, index into Mesh::triangles, -1 where no triangle covers the texel
+    // Per triangle, the weights of its first two corners (the third's is 1 - both) as affine functions of the
+    // texel's column and row: kept per triangle rather than per texel, which took 8 MB at 1024 texels.
+    struct Weights {
+        double c0 = 0.0, gx0 = 0.0, gy0 = 0.0, c1 = 0.0, gx1 = 0.0, gy1 = 0.0;
+    };
+    std::vector<Weights> weights;
+    // The barycentric weights of the first two corners of triangle `tri` (>= 0) at texel (x, y)'s centre.
+    cv::Vec2d barycentric(int tri, int x, int y) const {
+        const Weights& w = weights[static_cast<std::size_t>(tri)];
+        return {w.c0 + w.gx0 * x + w.gy0 * y, w.c1 + w.gx1 * x + w.gy1 * y};
+    }
 };
 
 TexelMap mapTexels(const Mesh& mesh, cv::Size size);
