@@ -22,3 +22,10 @@ endfunction()
 # assertions and set-up, and -O0 compiles a test source in about 30 % less time than -O2. The data tests stay at
 # the build's level: their helpers search meshes and scans vertex by vertex. Empty: the build type's flags.
 set(AVATARBOOTH_TEST_CODE_OPT "" CACHE STRING "Optimisation flag for the unit, integration, e2e, kernel and reliability tests' own sources (e.g. -O0)")
+
+# avatarbooth_test_code_opt(TARGET): compile TARGET's own sources with AVATARBOOTH_TEST_CODE_OPT when it is set.
+function(avatarbooth_test_code_opt target)
+  if(AVATARBOOTH_TEST_CODE_OPT)
+    target_compile_options(${target} PRIVATE ${AVATARBOOTH_TEST_CODE_OPT})
+  endif()
+endfunction()
