@@ -25,7 +25,7 @@ TexelMap mapTexels(const Mesh& mesh, cv::Size size) {
         for (int k = 0; k < 3; ++k) p[k] = glm::dvec2(mesh.uvs[idx[k]].x * w, mesh.uvs[idx[k]].y * h);
         const double area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
         if (std::abs(area) < 1e-12) continue;  // degenerate in UV (e.g. at a pole)
-        // The two weights below, b = (k + gx cx + gy cy) / area at the texel centre (cx, cy) = (x + 0.5, y + 0.5).
+        // The first two corners' weights, b = (k + gx cx + gy cy) / area at the texel centre (cx, cy) = (x + 0.5, y + 0.5).
         const double k0 = p[1].x * p[2].y - p[2].x * p[1].y, gx0 = p[1].y - p[2].y, gy0 = p[2].x - p[1].x;
         const double k1 = p[2].x * p[0].y - p[0].x * p[2].y, gx1 = p[2].y - p[0].y, gy1 = p[0].x - p[2].x;
         map.weights[ti] = {(k0 + 0.5 * (gx0 + gy0)) / area, gx0 / area, gy0 / area,
@@ -36,9 +36,8 @@ TexelMap mapTexels(const Mesh& mesh, cv::Size size) {
         const int y1 = std::min(size.height - 1, static_cast<int>(std::ceil(std::max({p[0].y, p[1].y, p[2].y}))));
         for (int y = y0; y <= y1; ++y) {
             for (int x = x0; x <= x1; ++x) {
-                const glm::dvec2 c(x + 0.5, y + 0.5);
-                const double b0 = ((p[1].x - c.x) * (p[2].y - c.y) - (p[2].x - c.x) * (p[1].y - c.y)) / area;
-                const double b1 = ((p[2].x - c.x) * (p[0].y - c.y) - (p[0].x - c.x) * (p[2].y - c.y)) / area;
+                const cv::Vec2d b = map.barycentric(static_cast<int>(ti), x, y);
+                const double b0 = b[0], b1 = b[1];
                 constexpr double eps = -1e-9;
                 if (b0 < eps || b1 < eps || 1.0 - b0 - b1 < eps) continue;
                 map.triangle.at<int>(y, x) = static_cast<int>(ti);
