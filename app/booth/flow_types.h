@@ -206,7 +206,8 @@ struct ScreenModel {
     Millis sinceEntered{0};          // time in this screen (for blinking and animations)
     Photo photo = Photo::Front;      // guide, countdown, capture: which photo
     Hint hint = Hint::None;          // guides
-    int countdown = 0;               // countdown: the number shown (3, 2, 1)
+    int countdown = 0;               // countdown: the number shown (3, 2, 1), a new one every second
+    Millis countdownAge{0};          // countdown: time since the number shown came up
     double progress = 0.0;           // processing: 0..1
     std::optional<FitStep> fitStep;  // processing: the step the fit is in (none before the first)
     std::string code;                // thanks: the session's short code (empty while saving)

@@ -468,8 +468,10 @@ void VisitorFlow::syncScreen(FlowTime t) {
     if (state_ == State::Countdown) {
         const auto left = settings_.countdown - s.sinceEntered;
         s.countdown = static_cast<int>(std::max<long long>(1, (left.count() + 999) / 1000));
+        s.countdownAge = s.sinceEntered - std::max(Millis(0), settings_.countdown - Millis(1000) * s.countdown);
     } else {
         s.countdown = 0;
+        s.countdownAge = Millis(0);
     }
     // A lost camera outranks every other message; the operator menu shows the camera's state on its own.
     if (!cameraOk_ && state_ != State::Operator) {

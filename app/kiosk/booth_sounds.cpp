@@ -51,8 +51,26 @@ std::unique_ptr<BoothSounds> BoothSounds::open(const SoundSettings& settings, st
 
 void BoothSounds::screen(const ScreenModel& screen, SoundPlayer::Time when) {
     const auto cue = cues_.screen(screen);
+    if (ahead_ && (screen.id != ScreenId::Countdown || screen.countdown > ahead_->number + 1)) {
+        player_.cancel(ahead_->voice);  // the countdown ended (or started again) before that number came
+        ahead_.reset();
+    }
     if (!cue) return;
-    player_.play(*cue == SoundCue::Tick ? tick_ : *cue == SoundCue::Shutter ? shutter_ : reveal_, when);
+    if (*cue != SoundCue::Tick) {
+        player_.play(*cue == SoundCue::Shutter ? shutter_ : reveal_, when);
+        return;
+    }
+    const SoundPlayer::Time due = when - screen.countdownAge;
+    // The beep asked for ahead stands when its number came when it was expected to (within a few ms).
+    const bool askedAhead = ahead_ && ahead_->number == screen.countdown &&
+                            std::chrono::abs(ahead_->due - due) <= std::chrono::milliseconds(5);
+    if (ahead_ && !askedAhead) player_.cancel(ahead_->voice);
+    if (!askedAhead) player_.play(tick_, due);
+    ahead_.reset();
+    if (screen.countdown > 1) {
+        const SoundPlayer::Time next = due + std::chrono::seconds(1);
+        ahead_ = AheadTick{screen.countdown - 1, next, player_.play(tick_, next)};
+    }
 }
 
 }  // namespace avatarbooth

@@ -33,6 +33,9 @@ public:
     static std::unique_ptr<BoothSounds> open(const SoundSettings& settings, std::string& note);
 
     // Plays the cue of `screen`, if it has one, as of `when` (the moment the screen changed; returns at once).
+    // The countdown's beeps keep its rhythm however late the loop comes round: each number's beep is asked for
+    // when that number came up (`countdownAge` before `when`), and the next number's a second after it, ahead of
+    // time; a beep asked for ahead is taken back when the countdown ends early or its number comes at another time.
     void screen(const ScreenModel& screen, SoundPlayer::Time when = std::chrono::steady_clock::now());
 
     SoundPlayer& player() { return player_; }
@@ -42,6 +45,12 @@ private:
     SoundPlayer player_;
     SoundCues cues_;
     int tick_ = -1, shutter_ = -1, reveal_ = -1;
+    struct AheadTick {
+        int number;
+        SoundPlayer::Time due;
+        long long voice;
+    };
+    std::optional<AheadTick> ahead_;  // the next number's beep, asked for ahead of time
 };
 
 }  // namespace avatarbooth

@@ -20,6 +20,7 @@ void Screenshots::frame(const ScreenModel& screen, const cv::Mat& drawn, bool co
     if (dir_.empty()) return;
     // A new screen, or another page of the operator menu, gets its own picture.
     if (screen.id != lastScreen_ || (screen.id == ScreenId::OperatorMenu && screen.menuPage != lastMenuPage_)) {
+        if (due_ && !lastDrawn_.empty()) write(next_++, lastModel_, lastDrawn_, false);
         lastMenuPage_ = screen.menuPage;
         due_ = true;
         provisional_ = -1;
@@ -33,6 +34,12 @@ void Screenshots::frame(const ScreenModel& screen, const cv::Mat& drawn, bool co
         if (!everything) provisional_ = next_;
         write(next_++, screen, drawn, false);
         due_ = false;
+    }
+    if (due_) {
+        drawn.copyTo(lastDrawn_);
+        lastModel_ = screen;
+    } else {
+        lastDrawn_.release();
     }
 }
 

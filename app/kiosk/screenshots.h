@@ -18,7 +18,9 @@ public:
 
     // Called every frame with the screen drawn. `complete`: the screen has what it is pictured for; `everything`:
     // it also has what may come later (a guide's first hint, the toon): a picture taken without it is taken again,
-    // under the same name, once it has.
+    // under the same name, once it has. A screen the visitor left before it was complete (a keep pressed while a
+    // style was still being made, on a busy machine) is pictured as it was last drawn: every screen shown has its
+    // picture.
     void frame(const ScreenModel& screen, const cv::Mat& drawn, bool complete, bool everything);
     const std::vector<std::filesystem::path>& written() const { return written_; }
 
@@ -30,6 +32,8 @@ private:
     bool due_;
     int next_ = 0;
     int provisional_ = -1;  // the index of a picture to take again
+    cv::Mat lastDrawn_;     // the screen due for its picture as last drawn (a copy: the caller draws into one image)
+    ScreenModel lastModel_;
     ScreenId lastScreen_ = ScreenId::Attract;
     OperatorPage lastMenuPage_ = OperatorPage::Menu;
 };

@@ -46,11 +46,17 @@ int SoundPlayer::add(SoundClip clip) {
     return static_cast<int>(clips_.size()) - 1;
 }
 
-void SoundPlayer::play(int id, Time when) {
+long long SoundPlayer::play(int id, Time when) {
     std::lock_guard lock(mutex_);
-    if (id < 0 || id >= static_cast<int>(clips_.size())) return;
+    if (id < 0 || id >= static_cast<int>(clips_.size())) return -1;
     const double at = std::chrono::duration<double>(when - anchor_).count() + lead();
-    voices_.push_back({id, anchorFrame_ + static_cast<long long>(std::llround(at * kSoundRate))});
+    voices_.push_back({nextVoice_, id, anchorFrame_ + static_cast<long long>(std::llround(at * kSoundRate))});
+    return nextVoice_++;
+}
+
+void SoundPlayer::cancel(long long voice) {
+    std::lock_guard lock(mutex_);
+    std::erase_if(voices_, [voice](const Voice& v) { return v.id == voice && !v.mixed; });
 }
 
 void SoundPlayer::run() {
@@ -77,7 +83,7 @@ void SoundPlayer::run() {
                 const SoundClip& clip = clips_[static_cast<std::size_t>(v->clip)];
                 // A clip asked for late (its first frame already written) starts at once.
                 if (!v->mixed && v->startFrame < written) v->startFrame = written;
-                v->mixed = true;
+                if (v->startFrame < written + kPeriodFrames) v->mixed = true;  // it sounds from this period on
                 const long long from = v->startFrame - written;  // frames into this period it starts
                 for (long long f = std::max(0LL, from); f < kPeriodFrames; ++f) {
                     const long long c = written + f - v->startFrame;

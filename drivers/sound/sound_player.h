@@ -35,8 +35,12 @@ public:
 
     // Registers a clip before use; returns its id for play().
     int add(SoundClip clip);
-    // Starts clip `id` at `when` + lead() (from any thread; returns at once). Clips overlap by mixing.
-    void play(int id, Time when = std::chrono::steady_clock::now());
+    // Starts clip `id` at `when` + lead() (from any thread; returns at once). Clips overlap by mixing. `when` may
+    // lie in the future: the clip waits for its time. Returns the voice, for cancel(); -1 for an unknown clip.
+    long long play(int id, Time when = std::chrono::steady_clock::now());
+    // Takes back a voice that has not started to sound (a cue asked for ahead of its time that no longer holds);
+    // a voice already playing, finished or unknown is left as it is.
+    void cancel(long long voice);
 
     Time started() const { return started_; }
     // Seconds from play() to the sound: more than the stream is written ahead of real time (kAhead), so that a clip
@@ -49,6 +53,7 @@ public:
 
 private:
     struct Voice {
+        long long id;
         int clip;
         long long startFrame;  // in stream frames
         bool mixed = false;    // its first period has been mixed
@@ -61,6 +66,7 @@ private:
     std::vector<SoundClip> clips_;
     std::mutex mutex_;
     std::vector<Voice> voices_;  // asked for and not finished
+    long long nextVoice_ = 0;
     Time anchor_;                // the steady time of stream frame anchorFrame_ (re-anchored after an underrun)
     long long anchorFrame_ = 0;
     std::atomic<bool> quit_{false};

@@ -129,6 +129,51 @@ TEST(BoothSounds, RecordedWavHasTheBeepsAtTheCountdownsTimes) {
     EXPECT_GT(w.seconds(), 2.5);
 }
 
+// The loop that shows the countdown can come round late (a frame held up by the fit or a busy machine): the beeps
+// still come a second apart, where each number came up, and a countdown left early (the camera lost) takes back
+// the beep it had asked for ahead.
+TEST(BoothSounds, CountdownBeepsKeepTheirRhythmWhenTheLoopIsLate) {
+    const fs::path dir = scratchDir("booth_sounds_late");
+    const fs::path wav = dir / "late.wav";
+    std::string note;
+    Clock::time_point started;
+    {
+        auto sounds = BoothSounds::open(recordingInto(wav), note);
+        if (!sounds && !haveTheme()) GTEST_SKIP() << "sound-theme-freedesktop is not installed (tests/setup.sh installs it)";
+        ASSERT_TRUE(sounds) << note;
+        started = sounds->player().started();
+        // {when the loop shows it (s), the screen, how long ago its number came up (ms)}: number 2 seen 250 ms
+        // late, number 1 40 ms late; then a second countdown left for the guide after its first number.
+        struct Step {
+            double at;
+            ScreenId id;
+            int number;
+            int ageMs;
+        };
+        const std::vector<Step> script{{0.20, ScreenId::FrontGuide, 0, 0}, {0.30, ScreenId::Countdown, 3, 0},
+                                       {1.55, ScreenId::Countdown, 2, 250}, {2.34, ScreenId::Countdown, 1, 40},
+                                       {3.30, ScreenId::CaptureFlash, 0, 0}, {3.40, ScreenId::SideGuide, 0, 0},
+                                       {4.30, ScreenId::Countdown, 3, 0},   {4.80, ScreenId::SideGuide, 0, 0}};
+        for (const Step& step : script) {
+            std::this_thread::sleep_until(started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(step.at)));
+            ScreenModel screen = screenOf(step.id, step.number);
+            screen.countdownAge = Millis(step.ageMs);
+            sounds->screen(screen, Clock::now());
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(1300));  // past where the abandoned "2" would sound
+    }
+    const Wav w = readWav(wav);
+    ASSERT_EQ(w.rate, kSoundRate);
+    const std::vector<double> heard = onsets(w);
+    std::string times;
+    for (double h : heard) times += " " + std::to_string(h);
+    // Three beeps, the shutter, one beep of the countdown left early: nothing a second after it.
+    ASSERT_EQ(heard.size(), 5u) << times;
+    EXPECT_NEAR(heard[1] - heard[0], 1.0, 0.003) << times;
+    EXPECT_NEAR(heard[2] - heard[1], 1.0, 0.003) << times;
+    EXPECT_NEAR(heard[4] - heard[0], 4.00, 0.003) << times;  // the second countdown's first number, on time
+}
+
 TEST(BoothSounds, VolumeScalesAndZeroIsSilent) {
     if (!haveTheme()) GTEST_SKIP() << "sound-theme-freedesktop is not installed (tests/setup.sh installs it)";
     const fs::path dir = scratchDir("booth_sounds_volume");

@@ -143,12 +143,16 @@ TEST(VisitorFlow, WholeSessionKept) {
     EXPECT_EQ(b.screen(), ScreenId::Countdown);
     EXPECT_EQ(b.model().photo, Photo::Front);
     EXPECT_EQ(b.model().countdown, 3);
+    EXPECT_EQ(b.model().countdownAge, Millis(0));
     b.tickAt(t0 + 1.999);
     EXPECT_EQ(b.model().countdown, 3);
+    EXPECT_LE(std::abs(b.model().countdownAge.count() - 999), 1);  // (the test's seconds are doubles)
     b.tickAt(t0 + 2.0);
     EXPECT_EQ(b.model().countdown, 2);
+    EXPECT_LE(std::abs(b.model().countdownAge.count()), 1);
     b.tickAt(t0 + 3.5);
     EXPECT_EQ(b.model().countdown, 1);
+    EXPECT_LE(std::abs(b.model().countdownAge.count() - 500), 1);  // the beep for 1 was due 500 ms before this step
     EXPECT_EQ(b.tickAt(t0 + 4.0), (Names{kLampsFlash, "CapturePhoto(front)"}));
     EXPECT_EQ(b.screen(), ScreenId::CaptureFlash);
 
