@@ -222,6 +222,8 @@ struct ScreenModel {
 };
 
 const char* toString(ScreenId id);
+// The screens that guide the visitor to a photo (the live preview with its hints).
+inline bool isGuide(ScreenId s) { return s == ScreenId::FrontGuide || s == ScreenId::SideGuide; }
 const char* toString(Hint hint);
 const char* toString(Button button);
 // The button toString names ("start", "retake", "service"); nothing for any other word. The one mapping from the

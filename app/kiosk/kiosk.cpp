@@ -86,7 +86,6 @@ LampPattern patternOf(LampMode mode, Clock& clock) {
     return LampPattern::off();
 }
 
-bool isGuide(ScreenId s) { return s == ScreenId::FrontGuide || s == ScreenId::SideGuide; }
 
 class Kiosk {
 public:

@@ -12,7 +12,6 @@ namespace avatarbooth {
 namespace {
 using Seconds = std::chrono::duration<double>;
 
-bool isGuide(ScreenId s) { return s == ScreenId::FrontGuide || s == ScreenId::SideGuide; }
 }  // namespace
 
 void KioskFigures::frame(const Frame& f) {

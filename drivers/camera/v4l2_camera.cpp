@@ -316,10 +316,9 @@ void V4l2Camera::stopStreaming() noexcept {
 }
 
 std::optional<CameraFrame> V4l2Camera::readFrame(std::chrono::milliseconds timeout) {
-    using Clock = std::chrono::steady_clock;
-    const auto deadline = Clock::now() + timeout;
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
     for (;;) {
-        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
         pollfd p{fd_, POLLIN, 0};
         const int r = ::poll(&p, 1, static_cast<int>(std::max<long long>(0, left.count())));
         if (r < 0) {
@@ -355,7 +354,7 @@ std::optional<CameraFrame> V4l2Camera::readFrame(std::chrono::milliseconds timeo
         if ((buf.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC)
             frame.timestamp = std::chrono::seconds(buf.timestamp.tv_sec) + std::chrono::microseconds(buf.timestamp.tv_usec);
         else
-            frame.timestamp = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch());
+            frame.timestamp = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch());
         // QBUF writes the buffer's new (queued) state back into `buf`: read the frame's fields before it.
         if (xioctl(fd_, VIDIOC_QBUF, &buf) != 0) fail("VIDIOC_QBUF", errno);
         if (image.empty()) {

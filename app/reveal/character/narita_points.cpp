@@ -15,8 +15,6 @@ namespace {
 
 constexpr double kStep = 0.5;  // pixels between samples along a search line
 
-double dot(const cv::Point2d& a, const cv::Point2d& b) { return a.x * b.x + a.y * b.y; }
-double norm(const cv::Point2d& a) { return std::sqrt(dot(a, a)); }
 
 cv::Point2d mean(const std::array<cv::Point2d, 68>& p, int from, int to) {
     cv::Point2d sum(0.0, 0.0);
@@ -62,13 +60,13 @@ struct FaceFrame {
     cv::Point2d eyeMid, u, v;
     double eyeDistance = 0.0;
     cv::Point2d along(double t) const { return eyeMid + t * v; }
-    double height(const cv::Point2d& p) const { return dot(p - eyeMid, v); }
+    double height(const cv::Point2d& p) const { return (p - eyeMid).dot(v); }
 };
 
 // The jaw contour's distance from the midline (along the eye line) at height t; above its first point, that
 // point's distance.
 double contourHalfWidth(const std::vector<cv::Point2d>& jaw, const FaceFrame& frame, double t) {
-    const auto offset = [&](const cv::Point2d& q) { return std::abs(dot(q - frame.eyeMid, frame.u)); };
+    const auto offset = [&](const cv::Point2d& q) { return std::abs((q - frame.eyeMid).dot(frame.u)); };
     if (t >= frame.height(jaw.front())) return offset(jaw.front());
     for (std::size_t i = 0; i + 1 < jaw.size(); ++i) {
         const double h0 = frame.height(jaw[i]), h1 = frame.height(jaw[i + 1]);
@@ -93,7 +91,7 @@ Outline outlineAt(const cv::Mat& mask, const FaceFrame& frame, cv::Point2d start
                   const std::vector<cv::Point2d>& jaw, const NaritaMappingSettings& s) {
     const double contour = contourHalfWidth(jaw, frame, t);
     const auto edge = edgeAlong(mask, start, out, s.maxReach * frame.eyeDistance, s.gapBridge * frame.eyeDistance);
-    if (edge && dot(edge->point - frame.along(t), out) >= contour - s.contourTolerance * frame.eyeDistance)
+    if (edge && (edge->point - frame.along(t)).dot(out) >= contour - s.contourTolerance * frame.eyeDistance)
         return {edge->point, true, edge->cut};
     return {frame.along(t) + contour * out, false, false};
 }
@@ -186,12 +184,12 @@ NaritaMapping mapNaritaPoints(const NaritaMappingInput& in, const NaritaMappingS
     FaceFrame frame;
     const cv::Point2d rightEye = mean(p, 36, 41), leftEye = mean(p, 42, 47);
     frame.eyeMid = 0.5 * (rightEye + leftEye);
-    frame.eyeDistance = norm(leftEye - rightEye);
+    frame.eyeDistance = cv::norm(leftEye - rightEye);
     if (!(frame.eyeDistance > 4.0))
         throw BoothError(ErrorKind::NoFace, "", "character points: the eye centres are less than 4 px apart");
     frame.u = (leftEye - rightEye) * (1.0 / frame.eyeDistance);
     frame.v = cv::Point2d(frame.u.y, -frame.u.x);
-    if (dot(at(8) - frame.eyeMid, frame.v) > 0.0) frame.v = -frame.v;
+    if ((at(8) - frame.eyeMid).dot(frame.v) > 0.0) frame.v = -frame.v;
 
     NaritaMapping out;
     NaritaPoints& P = out.points;
@@ -267,7 +265,7 @@ NaritaMapping mapNaritaPoints(const NaritaMappingInput& in, const NaritaMappingS
 
 void drawNaritaPoints(cv::Mat& canvas, const NaritaMapping& mapping) {
     const NaritaPoints& P = mapping.points;
-    const double scale = std::max(1.0, norm(P.f[1] - P.f[0]) / 200.0);
+    const double scale = std::max(1.0, cv::norm(P.f[1] - P.f[0]) / 200.0);
     const int radius = static_cast<int>(std::lround(2.0 * scale));
     cv::line(canvas, P.f[0], P.f[1], cv::Scalar(80, 200, 80), 1, cv::LINE_AA);  // the face line
     for (const auto& [name, q] : P.named()) {

@@ -11,13 +11,10 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
-double dot(const cv::Point2d& a, const cv::Point2d& b) { return a.x * b.x + a.y * b.y; }
-double cross(const cv::Point2d& a, const cv::Point2d& b) { return a.x * b.y - a.y * b.x; }
-double norm(const cv::Point2d& a) { return std::sqrt(dot(a, a)); }
 
 // |X sin θ| and |X cos θ|, θ the angle between the face line `line` and X: X's components across and along it.
-double across(const cv::Point2d& X, const cv::Point2d& line) { return std::abs(cross(line, X)) / norm(line); }
-double along(const cv::Point2d& X, const cv::Point2d& line) { return std::abs(dot(line, X)) / norm(line); }
+double across(const cv::Point2d& X, const cv::Point2d& line) { return std::abs(line.cross(X)) / cv::norm(line); }
+double along(const cv::Point2d& X, const cv::Point2d& line) { return std::abs(line.dot(X)) / cv::norm(line); }
 
 cv::Point2d centre(const std::array<cv::Point2d, 10>& e, std::size_t first) {
     cv::Point2d sum(0.0, 0.0);
@@ -29,7 +26,7 @@ cv::Point2d centre(const std::array<cv::Point2d, 10>& e, std::size_t first) {
 // chin). `outwards` is the face line's direction on that side, `up` the face's up.
 double tiltDeg(const cv::Point2d& inner, const cv::Point2d& outer, const cv::Point2d& outwards, const cv::Point2d& up) {
     const cv::Point2d d = outer - inner;
-    return std::atan2(dot(d, up), dot(d, outwards)) * kRadToDeg;
+    return std::atan2(d.dot(up), d.dot(outwards)) * kRadToDeg;
 }
 
 // Slider ranges. The middle of each is about what the built-in base head (an average adult face) measures with
@@ -60,7 +57,7 @@ constexpr std::array<SliderRange, 11> kSliders = {{
 CharacterProportions computeProportions(const NaritaPoints& P) {
     CharacterProportions out;
     const cv::Point2d line = P.f[1] - P.f[0];
-    out.lf0 = norm(line);
+    out.lf0 = cv::norm(line);
     if (!(out.lf0 > 0.0)) throw BoothError(ErrorKind::NoFace, "", "character proportions: the temples coincide");
     const double w = out.lf0;
     out.lf1 = 2.0 * across(P.f[2] - P.f[0], line);
@@ -77,7 +74,7 @@ CharacterProportions computeProportions(const NaritaPoints& P) {
 
     const cv::Point2d u = line * (1.0 / w);
     cv::Point2d up(u.y, -u.x);
-    if (dot(P.f[2] - P.f[0], up) > 0.0) up = -up;
+    if ((P.f[2] - P.f[0]).dot(up) > 0.0) up = -up;
     out.eyeTiltDeg = 0.5 * (tiltDeg(P.e[1], P.e[0], -u, up) + tiltDeg(P.e[6], P.e[5], u, up));
     out.browTiltDeg = 0.5 * (tiltDeg(P.b[0], P.browOuter[0], -u, up) + tiltDeg(P.b[1], P.browOuter[1], u, up));
     return out;
