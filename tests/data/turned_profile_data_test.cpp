@@ -83,9 +83,10 @@ TEST(TurnedProfiles, FitFrom70To110AndSayWhichWayToTurnBeyond) {
                 const SideAnalysis a = analyseSidePhoto(v.side, v.background, silhouetteOnly);
                 pastAt120 += yaw == 120 && a.turn.pastProfile;
                 pastWrongly += yaw >= 70 && yaw <= 110 && a.turn.pastProfile;
-                cues = cv::format("eye %.3f turn %+.0f ear %s %.2f fold %.2f%s", a.turn.eyeBehind, a.turn.degrees,
-                                  a.turn.ear.found ? "at" : "-", a.turn.ear.front, a.turn.ear.fold,
-                                  a.turn.pastProfile ? " past" : "");
+                cues = cv::format("eye %.3f turn %+.0f ear %s %.2f (%.3f of the head) fold %.2f%s", a.turn.eyeBehind,
+                                  a.turn.degrees, a.turn.ear.found ? "at" : "-", a.turn.ear.front,
+                                  a.turn.ear.headLength > 0.0 ? a.turn.ear.front / a.turn.ear.headLength : 0.0,
+                                  a.turn.ear.fold, a.turn.pastProfile ? " past" : "");
             } catch (const BoothError&) {
             }
             std::printf("%4u %4d %5s  %-8s %7.2f  %s | %s\n", seed, yaw, options.sideNoseImageRight ? "right" : "left",
