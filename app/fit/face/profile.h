@@ -83,7 +83,7 @@ inline constexpr double kEarOverCheek = 4.0;
 
 // How far a side photo is turned from a true profile, from what the photo shows inside the outline: the outline
 // alone cannot tell (orthographically, a symmetric head turned 20 degrees short of the profile and one turned 20
-// degrees past it have the same outline). See profile.cpp for the cues, their calibration and their limits.
+// degrees past it have the same outline). The cues: profile.cpp; their calibration and limits: README, issue 22.
 struct ProfileTurn {
     bool known = false;
     // Degrees off the profile by the eye: < 0 not turned far enough (more of the face shows), > 0 turned past it
