@@ -45,7 +45,7 @@ Hint sideHint(const SideObservation& obs) {
     if (!obs.personSeen) return Hint::TurnRight;
     if (obs.frontalFace) return std::abs(obs.frontalYaw) > kHalfTurnedYaw ? Hint::TurnMore : Hint::TurnRight;
     if (!obs.profileSeen) return Hint::TurnMore;
-    if (obs.turnDegrees >= kTurnBackDegrees) return Hint::TurnBack;
+    if (obs.turnedBack) return Hint::TurnBack;
     return Hint::HoldStill;
 }
 
@@ -137,8 +137,14 @@ SideObservation PreviewAnalyser::observeSide(const cv::Mat& bgr, const cv::Mat& 
         obs.noseProminence = fit.noseProminence;
         obs.profileSeen = true;
         if (fit.ok) {
-            const ProfileTurn turn = estimateProfileTurn(small, mask, fit.landmarks, obs.noseImageRight);
+            // The ear's folds are a few pixels wide at the preview's size: the turn is read on the frame itself.
+            std::vector<ProfilePoint> landmarks = fit.landmarks;
+            for (auto& p : landmarks) p.px = p.px / scale;
+            cv::Mat frameMask;
+            cv::resize(mask, frameMask, bgr.size(), 0, 0, cv::INTER_NEAREST);
+            const ProfileTurn turn = estimateProfileTurn(bgr, frameMask, landmarks, obs.noseImageRight);
             if (turn.known) obs.turnDegrees = turn.degrees;
+            obs.turnedBack = turn.pastProfile;
         }
     }
     return obs;

@@ -68,12 +68,13 @@ struct SideObservation {
     double noseProminence = 0.0; // of the outline's best nose (ProfileFit::noseProminence), 0 when none
     double frontalYaw = 0.0;     // with frontalFace and a landmark detector: noseOffsetYaw of that face
     double turnDegrees = 0.0;    // with profileSeen: ProfileTurn::degrees (0 when unknown)
+    bool turnedBack = false;     // with profileSeen: ProfileTurn::pastProfile
 };
 
 // The side guide's hint: "turn to your right" while nobody or a frontal face looking at the camera is seen, "turn
 // more" while half-turned (a frontal face turned more than kHalfTurnedYaw, or an outline without a profile), "turn
-// a little back" when the profile is seen turned kTurnBackDegrees or more past it, else "hold still" (either way:
-// the fit takes both).
+// a little back" when the profile is seen turned clearly past it (ProfileTurn::pastProfile: the ear and the eye
+// agree), else "hold still" (either way: the fit takes both).
 Hint sideHint(const SideObservation& observation);
 
 // Runs the observations on preview frames. Holds the detectors; not thread-safe (one analyser per thread).

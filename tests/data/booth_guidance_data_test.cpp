@@ -78,6 +78,7 @@ TEST(GuidanceFrmdb, FrontsSayHoldStillAndProfilesAreSeen) {
             if (turned.landmarks) yaw = noseOffsetYaw(*turned.landmarks);  // as the front guide measures it
             const SideObservation turnedSide = analyser.observeSide(preview(readPhoto(dir / file)));
             turnedTakenForProfile += sideHint(turnedSide) == Hint::HoldStill;
+            EXPECT_NE(sideHint(turnedSide), Hint::TurnBack) << file << ": turned short of the profile, not past it";
             ++turnedViews;
             std::printf("frmdb %s (45 degrees): front hint %s, yaw %.2f; side hint %s\n", file.c_str(),
                         toString(hint), yaw, toString(sideHint(turnedSide)));

@@ -123,8 +123,14 @@ TEST(ProfileData, EveryFrmdbViewAsASidePhoto) {
             try {
                 const SideAnalysis a = analyseSidePhoto(bgr, cv::Mat(), options);
                 std::cout << "[ " << id << "/" << shot << " ] accepted; eye " << a.turn.eyeBehind << " V behind the outline, turn "
-                          << a.turn.degrees << " degrees\n";
+                          << a.turn.degrees << " degrees; ear "
+                          << (a.turn.ear.found ? cv::format("%.2f V behind the nose tip (%.3f of the head), folds %.2f",
+                                                            a.turn.ear.front, a.turn.ear.front / a.turn.ear.headLength,
+                                                            a.turn.ear.fold)
+                                               : std::string("not found"))
+                          << (a.turn.pastProfile ? ": past the profile" : "") << "\n";
                 EXPECT_NE(name, "Img_33") << "a front accepted";
+                EXPECT_FALSE(a.turn.pastProfile) << "none of frmdb's views is turned past the profile";
             } catch (const avatarbooth::FitError& e) {
                 std::cout << "[ " << id << "/" << shot << " ] refused: " << e.what() << "\n";
                 EXPECT_TRUE(name != "Img_13" && name != "Img_53") << "a profile refused: " << e.what();

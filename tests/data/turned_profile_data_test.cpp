@@ -1,6 +1,7 @@
 // Side photos as visitors give them (issue 22): MakeHuman visitors (sim/makehuman_visitor.h) photographed from the
 // side turned 60-120 degrees from the front, both ways round. 70-110 must fit, with the face's shape error near the
-// true profile's; 60 and 120 must be refused with the way to turn, by the fit and by the side guide. Needs the
+// true profile's; 60 and 120 must be refused with the way to turn, by the fit and by the side guide (at 120 the
+// guide's "turn a little back" reaches 2 of the 6, asserted with none at 70-110). Needs the
 // product's base head; skips when it is absent. AVATARBOOTH_TURNED_OUT=DIR keeps the side photos and overlays.
 #include "face_shape_error.h"
 #include "test_paths.h"
@@ -48,7 +49,7 @@ TEST(TurnedProfiles, FitFrom70To110AndSayWhichWayToTurnBeyond) {
     const fs::path out = outEnv && *outEnv ? fs::path(outEnv) : fs::path();
 
     std::map<int, std::vector<double>> rms;
-    int turnMoreAt60 = 0, turnBackAt120 = 0;
+    int turnMoreAt60 = 0, turnBackAt120 = 0, pastAt120 = 0, turnBackWrongly = 0, pastWrongly = 0;
     std::printf("%4s %4s %5s  %-8s %7s  %s\n", "seed", "yaw", "nose", "guide", "rms mm", "fit");
     for (unsigned seed = 1; seed <= kPeople; ++seed)
         for (const int yaw : kYaws) {
@@ -69,6 +70,7 @@ TEST(TurnedProfiles, FitFrom70To110AndSayWhichWayToTurnBeyond) {
             }
             turnMoreAt60 += yaw == 60 && hint == Hint::TurnMore;
             turnBackAt120 += yaw == 120 && hint == Hint::TurnBack;
+            turnBackWrongly += yaw >= 70 && yaw <= 110 && hint == Hint::TurnBack;
             double r = std::nan("");
             if (o) {
                 r = faceRms(o->fit.mesh, v.truthMesh, face, options.mmPerPixel / o->fit.front.mmPerPixel);
@@ -79,7 +81,12 @@ TEST(TurnedProfiles, FitFrom70To110AndSayWhichWayToTurnBeyond) {
                 SideOptions silhouetteOnly;
                 silhouetteOnly.rejectFrontViews = false;
                 const SideAnalysis a = analyseSidePhoto(v.side, v.background, silhouetteOnly);
-                cues = cv::format("eye %.3f turn %+.0f", a.turn.eyeBehind, a.turn.degrees);
+                pastAt120 += yaw == 120 && a.turn.pastProfile;
+                pastWrongly += yaw >= 70 && yaw <= 110 && a.turn.pastProfile;
+                cues = cv::format("eye %.3f turn %+.0f ear %s %.2f (%.3f of the head) fold %.2f%s", a.turn.eyeBehind,
+                                  a.turn.degrees, a.turn.ear.found ? "at" : "-", a.turn.ear.front,
+                                  a.turn.ear.headLength > 0.0 ? a.turn.ear.front / a.turn.ear.headLength : 0.0,
+                                  a.turn.ear.fold, a.turn.pastProfile ? " past" : "");
             } catch (const BoothError&) {
             }
             std::printf("%4u %4d %5s  %-8s %7.2f  %s | %s\n", seed, yaw, options.sideNoseImageRight ? "right" : "left",
@@ -87,14 +94,23 @@ TEST(TurnedProfiles, FitFrom70To110AndSayWhichWayToTurnBeyond) {
             if (!out.empty()) {
                 const fs::path dir = out / ("seed" + std::to_string(seed) + "_yaw" + std::to_string(yaw));
                 fs::create_directories(dir);
-                writeFileAtomically(dir / "side.jpg", encodeImage(v.side, ".jpg", 90));
+                writeFileAtomically(dir / "side.png", encodeImage(v.side, ".png"));
+                writeFileAtomically(dir / "background.png", encodeImage(v.background, ".png"));
                 if (o) writeFileAtomically(dir / "side_overlay.jpg", encodeImage(drawSideOverlayWithRays(*o), ".jpg", 90));
             }
         }
     std::printf("median face RMS (mm) by yaw:");
     for (const int yaw : kYaws) std::printf(" %d: %.2f (%zu fitted)", yaw, median(rms[yaw]), rms[yaw].size());
-    std::printf("\nside guide at 60 degrees: %d of %u say turn more; at 120: %d of %u say turn back\n", turnMoreAt60,
-                kPeople, turnBackAt120, kPeople);
+    std::printf("\nside guide at 60 degrees: %d of %u say turn more; at 120: %d of %u say turn back (%d at 70-110)\n",
+                turnMoreAt60, kPeople, turnBackAt120, kPeople, turnBackWrongly);
+    std::printf("side analysis: %d of %u past the profile at 120 degrees (%d at 70-110)\n", pastAt120, kPeople,
+                pastWrongly);
+    // "Turn a little back" only when the ear and the eye agree (README, issue 22): never at 70-110 degrees; at 120
+    // measured 2 of 6 (the ear's place differs between people by about as much as it moves from 110 to 120).
+    EXPECT_EQ(turnBackWrongly, 0) << "the side guide told a visitor turned 70-110 degrees to turn back";
+    EXPECT_EQ(pastWrongly, 0) << "a visitor turned 70-110 degrees read as past the profile";
+    EXPECT_GE(turnBackAt120, 2);
+    EXPECT_GE(pastAt120, 2);
     // Measured (6 people): 70 and 110 2.17 mm, 80 and 100 1.75, 90 1.59; every one fitted.
     for (const int yaw : {70, 80, 90, 100, 110}) {
         EXPECT_EQ(rms[yaw].size(), kPeople) << "yaw " << yaw << ": every visitor fits";

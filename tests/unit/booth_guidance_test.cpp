@@ -143,10 +143,10 @@ TEST(Guidance, SideHintSaysWhichWayToTurn) {
     EXPECT_EQ(sideHint(o), Hint::TurnMore);
     o = {};
     o.personSeen = o.profileSeen = true;
-    o.turnDegrees = 19.0;  // short of kTurnBackDegrees past the profile
+    o.turnDegrees = 30.0;  // the eye alone, however far past: it saturates and misreads past 110 degrees
     EXPECT_EQ(sideHint(o), Hint::HoldStill);
     o.turnDegrees = -40.0;  // short of the profile: the outline's own test says "turn more" when it fails
     EXPECT_EQ(sideHint(o), Hint::HoldStill);
-    o.turnDegrees = 20.0;
+    o.turnedBack = true;  // the ear and the eye agree
     EXPECT_EQ(sideHint(o), Hint::TurnBack);
 }

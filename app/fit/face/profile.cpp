@@ -33,6 +33,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <optional>
@@ -565,15 +566,110 @@ std::optional<cv::Rect> findFrontalFace(const cv::Mat& bgr, const cv::Mat& mask,
 
 // The turn from the near eye. Seen in profile the eye lies about 0.1 V behind the nose bridge's outline; turned
 // towards the camera it moves back (the face shows more: 60 degrees from the front, about 0.2 V), turned past the
-// profile it moves onto the outline and under the brow. Measured on 6 MakeHuman visitors turned 60-120 degrees
-// (tests/data/turned_profile_data_test.cpp): 0.06-0.13 V at 90 degrees (median 0.10), 0.15-0.18 at 70, 0.04-0.05
-// at 110, about 0.0033 V per degree between; on the 16 frmdb profiles 0.06-0.19 (median 0.14: real lashes and
-// brows are darker). Past about 110 degrees the eye is hidden and the darkest pixels are the cheek's shadow or
-// hair: the cue saturates there, and a dark-skinned face can read as turned the other way. It is a rough sign,
-// not a measurement: the side guide says "turn a little back" on it (kTurnBackDegrees), the fit refuses nothing
-// on it.
+// profile it moves onto the outline and under the brow. Past about 110 degrees the eye is hidden and the darkest
+// pixels are the cheek's shadow or hair: the cue saturates there, and a dark-skinned face can read as turned the
+// other way. So it only confirms the ear (turnedPastProfile). Calibration: README, issue 22.
 constexpr double kEyeBehindAtProfile = 0.10;
 constexpr double kEyeBehindPerDegree = 0.0033;
+
+namespace {
+
+// The ear: the skin's folds behind the cheek, on the rows from 0.2 V above the nose tip to 0.15 V below it (the
+// concha and the tragus; the top of the ear is the first part hair covers). Only pixels of the cheek's colour
+// (in YCrCb's chroma) with skin of that colour 0.03 V to either side count, so that a hairline's edge does not.
+// Returns each 0.01 V wide column's mean gradient there, from the nasion back (none when no cheek is seen).
+std::vector<double> earColumns(const cv::Mat& bgr, const cv::Mat& mask, const cv::Point2d& nasion,
+                               const cv::Point2d& tip, double V, const std::function<int(int)>& frontEdge) {
+    // Filtered only around the face and the ear (a preview frame is the camera's whole picture), in the frame's
+    // coordinates: the images below are views of the region inside full-frame headers.
+    const int margin = cvRound(0.1 * V) + 4;
+    const double top = std::min(nasion.y, tip.y - 0.2 * V);
+    const cv::Rect region = cv::Rect(cvRound(nasion.x - 1.1 * V) - margin, cvRound(top) - margin,
+                                     cvRound(1.1 * V + (tip.x - nasion.x)) + 2 * margin,
+                                     cvRound(tip.y + 0.15 * V - top) + 2 * margin) &
+                            cv::Rect(0, 0, bgr.cols, bgr.rows);
+    if (region.empty()) return {};
+    cv::Mat smooth, ycc, luma, gx, gy, grad, inner;
+    cv::GaussianBlur(bgr(region), smooth, {0, 0}, std::max(0.8, 0.008 * V));
+    cv::cvtColor(smooth, ycc, cv::COLOR_BGR2YCrCb);
+    cv::extractChannel(ycc, luma, 0);
+    luma.convertTo(luma, CV_32F);
+    cv::Sobel(luma, gx, CV_32F, 1, 0);
+    cv::Sobel(luma, gy, CV_32F, 0, 1);
+    cv::magnitude(gx, gy, grad);
+    const int r = cvRound(0.04 * V);
+    cv::erode(mask(region), inner, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}));
+    auto inRegion = [&](int x, int y) { return region.contains(cv::Point(x, y)); };
+    auto innerAt = [&](int x, int y) { return inRegion(x, y) && inner.at<unsigned char>(y - region.y, x - region.x); };
+    auto yccAt = [&](int x, int y) { return ycc.at<cv::Vec3b>(y - region.y, x - region.x); };
+    // The cheek's chroma: the median on the lower 60% of the rows from the nasion to the nose tip (a head turned
+    // past the profile has its nasion only 0.15 V above the tip), 0.12-0.25 V behind the face's edge.
+    std::vector<int> cr, cb;
+    const int cheekTop = std::max(0, cvRound(nasion.y + 0.4 * (tip.y - nasion.y)));
+    for (int y = cheekTop; y <= std::min(bgr.rows - 1, cvRound(tip.y)); ++y) {
+        const int edge = frontEdge(y);
+        if (edge < 0) continue;
+        for (int x = std::max(0, cvRound(edge - 0.25 * V)); x <= edge - 0.12 * V; ++x)
+            if (innerAt(x, y)) {
+                const cv::Vec3b p = yccAt(x, y);
+                cr.push_back(p[1]);
+                cb.push_back(p[2]);
+            }
+    }
+    if (cr.size() < 20) return {};  // no cheek seen
+    std::nth_element(cr.begin(), cr.begin() + cr.size() / 2, cr.end());
+    std::nth_element(cb.begin(), cb.begin() + cb.size() / 2, cb.end());
+    const int cr0 = cr[cr.size() / 2], cb0 = cb[cb.size() / 2];
+    constexpr int kChroma = 10;  // of 255: the cheek's colour under the booth's light, shading included
+    constexpr int kColumns = 100;  // 0.01 V each: 1 V behind the nasion
+    const int y0 = std::max(0, cvRound(tip.y - 0.2 * V)), y1 = std::min(bgr.rows - 1, cvRound(tip.y + 0.15 * V));
+    const int side = cvRound(0.03 * V);
+    std::vector<double> column(kColumns, 0.0);
+    for (int y = y0; y <= y1; ++y) {
+        auto cheekSkin = [&](int x) {
+            if (!innerAt(x, y)) return false;
+            const cv::Vec3b p = yccAt(x, y);
+            return std::abs(p[1] - cr0) <= kChroma && std::abs(p[2] - cb0) <= kChroma;
+        };
+        for (int c = 0; c < kColumns; ++c) {
+            const int x = cvRound(nasion.x - (c + 0.5) * 0.01 * V);
+            if (cheekSkin(x) && cheekSkin(x - side) && cheekSkin(x + side))
+                column[static_cast<std::size_t>(c)] += grad.at<float>(y - region.y, x - region.x);
+        }
+    }
+    for (double& c : column) c /= (y1 - y0 + 1);
+    return column;
+}
+
+}  // namespace
+
+EarPlace readEarColumns(const std::vector<double>& columns, double noseAhead, double headLength) {
+    EarPlace ear;
+    ear.headLength = headLength;
+    const int n = static_cast<int>(columns.size());
+    if (n < 30) return ear;
+    std::vector<double> level(columns.size(), 0.0);
+    for (int c = 0; c < n; ++c) {
+        const int from = std::max(0, c - 2), to = std::min(n - 1, c + 2);
+        double sum = 0.0;
+        for (int d = from; d <= to; ++d) sum += columns[static_cast<std::size_t>(d)];
+        level[static_cast<std::size_t>(c)] = sum / (to - from + 1);
+    }
+    const double cheek = std::max(1.0, *std::min_element(level.begin() + 12, level.begin() + 26));
+    const auto strongest = std::max_element(level.begin() + 15, level.end());
+    if (*strongest < kEarOverCheek * cheek) return ear;
+    const auto front = std::find_if(level.begin() + 20, level.end(), [&](double v) { return v > kEarOverCheek * cheek; });
+    if (front == level.end()) return ear;  // only the eye's corner or the nose's wing stands out
+    ear.found = true;
+    ear.front = (static_cast<double>(front - level.begin()) + 0.5) * 0.01 + noseAhead;
+    ear.fold = (static_cast<double>(strongest - level.begin()) + 0.5) * 0.01 + noseAhead;
+    return ear;
+}
+
+bool turnedPastProfile(double eyeDegrees, const EarPlace& ear) {
+    return ear.found && ear.headLength > 0.0 && ear.front / ear.headLength <= kEarShareTurnBack &&
+           ear.fold <= kEarFoldTurnBack && eyeDegrees >= kEyeTurnBackDegrees;
+}
 
 ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, const std::vector<ProfilePoint>& landmarks,
                                 bool noseImageRight) {
@@ -599,7 +695,7 @@ ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, con
     cv::Mat grey;
     cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
     // The face's front edge on a row: the last mask pixel at or before the nose tip's column.
-    auto frontEdge = [&](int y) {
+    const std::function<int(int)> frontEdge = [&](int y) {
         const auto* m = mask.ptr<unsigned char>(y);
         for (int x = std::min(mask.cols - 1, cvRound(tip.x) + 2); x >= 0; --x)
             if (m[x]) return x;
@@ -627,6 +723,9 @@ ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, con
     if (turn.eyeBehind <= 0.0) return turn;
     turn.degrees = (kEyeBehindAtProfile - turn.eyeBehind) / kEyeBehindPerDegree;
     turn.known = true;
+    turn.ear = readEarColumns(earColumns(bgr, mask, nasion, tip, V, frontEdge), (tip.x - nasion.x) / V,
+                              (pt("glabella").x - pt("back_of_head").x) / V);
+    turn.pastProfile = turnedPastProfile(turn.degrees, turn.ear);
     return turn;
 }
 

@@ -60,20 +60,52 @@ std::vector<ProfilePoint> findProfileLandmarks(const std::vector<cv::Point2d>& o
 // The point called `name`; throws BoothError(Internal) when it is missing.
 cv::Point2d profilePoint(const std::vector<ProfilePoint>& points, std::string_view name);
 
+// Where the ear shows behind the cheek of a side photo, in V behind the nose tip (horizontally): where its skin's
+// folds begin (the front of the ear: the tragus and the helix's root) and where they are strongest. Unlike the
+// outline, it tells a head turned past the profile from one turned short of it: the ear comes towards the face.
+// Heads differ in length, and their ears with them: the front's share of the head's length (headLength: glabella
+// to the back of the head, in V; the same 20 degrees either side of the profile) is what says the turn.
+struct EarPlace {
+    bool found = false;
+    double front = 0.0;
+    double fold = 0.0;
+    double headLength = 0.0;
+};
+
+// Reads the ear from the skin's folds per column behind the nasion (columns[i]: the mean gradient of cheek-coloured
+// skin 0.01*i to 0.01*(i+1) V behind it; at least 30 columns), the nose tip lying noseAhead V in front of the
+// nasion. The columns are smoothed over 0.05 V; the cheek's level is the smallest 0.12-0.26 V behind the nasion;
+// the ear's front is the first column past 0.2 V more than kEarOverCheek times that, its fold the strongest
+// column past 0.15 V. Not found when the strongest is not kEarOverCheek times the cheek's level (a textured
+// cheek: stubble, hair over it). Pure function.
+EarPlace readEarColumns(const std::vector<double>& columns, double noseAhead, double headLength);
+inline constexpr double kEarOverCheek = 4.0;
+
 // How far a side photo is turned from a true profile, from what the photo shows inside the outline: the outline
 // alone cannot tell (orthographically, a symmetric head turned 20 degrees short of the profile and one turned 20
-// degrees past it have the same outline). See profile.cpp for the cue, its calibration and its limits.
+// degrees past it have the same outline). The cues: profile.cpp; their calibration and limits: README, issue 22.
 struct ProfileTurn {
     bool known = false;
-    // Degrees off the profile: < 0 not turned far enough (more of the face shows), > 0 turned past it (more of
-    // the back of the head shows).
+    // Degrees off the profile by the eye: < 0 not turned far enough (more of the face shows), > 0 turned past it
+    // (more of the back of the head shows).
     double degrees = 0.0;
     double eyeBehind = 0.0;  // the visible eye's distance behind the face's outline, in V
+    EarPlace ear;
+    bool pastProfile = false;  // turnedPastProfile(degrees, ear): the visitor should turn a little back
 };
 
 // The turn of a side photo whose profile landmarks are known (facing as noseImageRight says).
 ProfileTurn estimateProfileTurn(const cv::Mat& bgr, const cv::Mat& mask, const std::vector<ProfilePoint>& landmarks,
                                 bool noseImageRight);
+
+// Whether the two cues agree that the head is turned clearly past the profile (about 120 degrees from the front):
+// the ear's front lies within kEarShareTurnBack of the head's length behind the nose tip, its strongest folds
+// within kEarFoldTurnBack (a second reading of the same ear, against the hair or skin texture taken for it), and
+// the eye (eyeDegrees, ProfileTurn::degrees) says past as well. Pure function. Calibration: README, issue 22.
+bool turnedPastProfile(double eyeDegrees, const EarPlace& ear);
+inline constexpr double kEarShareTurnBack = 0.318;
+inline constexpr double kEarFoldTurnBack = 0.60;  // V behind the nose tip
+inline constexpr double kEyeTurnBackDegrees = 8.0;
 
 struct SideAnalysis {
     cv::Mat mask;                        // CV_8U, 255 on the person (see segmentPerson)
@@ -121,10 +153,6 @@ double noseOffsetYaw(const std::array<cv::Point2d, 68>& points);
 // Beyond this |noseOffsetYaw| a face is half-turned (the front guide's maxYaw: frmdb's fronts -0.23 to 0.15, its
 // 45-degree views 0.28-0.38 where the frontal cascade still finds them).
 inline constexpr double kHalfTurnedYaw = 0.26;
-// The side guide says "turn a little back" when ProfileTurn puts the visitor this far past the profile: the eye
-// within 0.034 V of the outline. Measured maxima: +19 on MakeHuman visitors turned 110 and 120 degrees (the cue
-// saturates there), +16 on frmdb's profiles; so it fires only on a head turned further than those.
-inline constexpr double kTurnBackDegrees = 20.0;
 
 // Analyses a side photo: silhouette (with the empty-booth plate when not empty), facing direction (either way
 // works: the outline is fitted both ways, a nose pointing left is fitted mirrored and the points mapped back),
