@@ -20,7 +20,7 @@ void Screenshots::frame(const ScreenModel& screen, const cv::Mat& drawn, bool co
     if (dir_.empty()) return;
     // A new screen, or another page of the operator menu, gets its own picture.
     if (screen.id != lastScreen_ || (screen.id == ScreenId::OperatorMenu && screen.menuPage != lastMenuPage_)) {
-        if (due_ && !lastDrawn_.empty()) write(next_++, lastModel_, lastDrawn_, false);
+        if (due_ && !lastDrawn_.empty() && lastModel_.sinceEntered >= kSeenFor) write(next_++, lastModel_, lastDrawn_, false);
         lastMenuPage_ = screen.menuPage;
         due_ = true;
         provisional_ = -1;

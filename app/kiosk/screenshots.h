@@ -19,9 +19,11 @@ public:
     // Called every frame with the screen drawn. `complete`: the screen has what it is pictured for; `everything`:
     // it also has what may come later (a guide's first hint, the toon): a picture taken without it is taken again,
     // under the same name, once it has. A screen the visitor left before it was complete (a keep pressed while a
-    // style was still being made, on a busy machine) is pictured as it was last drawn: every screen shown has its
-    // picture.
+    // style was still being made, on a busy machine) is pictured as it was last drawn when it was shown for
+    // kSeenFor at least: a screen passed through in a moment (a countdown cut short by a lost camera) is not one
+    // the visitor saw.
     void frame(const ScreenModel& screen, const cv::Mat& drawn, bool complete, bool everything);
+    static constexpr Millis kSeenFor{700};
     const std::vector<std::filesystem::path>& written() const { return written_; }
 
 private:
