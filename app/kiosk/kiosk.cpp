@@ -86,7 +86,6 @@ LampPattern patternOf(LampMode mode, Clock& clock) {
     return LampPattern::off();
 }
 
-
 class Kiosk {
 public:
     Kiosk(const BoothConfig& config, const KioskOptions& options, SteadyClockTime startup);

@@ -11,7 +11,6 @@ namespace avatarbooth {
 
 namespace {
 using Seconds = std::chrono::duration<double>;
-
 }  // namespace
 
 void KioskFigures::frame(const Frame& f) {
