@@ -692,8 +692,6 @@ ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, con
     const cv::Point2d nasion = pt("nasion"), tip = pt("nose_tip"), top = pt("top_of_head");
     const double V = tip.y - top.y;
     if (V < 20.0) return turn;
-    cv::Mat grey;
-    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
     // The face's front edge on a row: the last mask pixel at or before the nose tip's column.
     const std::function<int(int)> frontEdge = [&](int y) {
         const auto* m = mask.ptr<unsigned char>(y);
@@ -706,11 +704,15 @@ ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, con
     {
         std::vector<std::pair<int, double>> pixels;  // grey, distance behind the edge in V
         const int y0 = std::max(0, cvRound(nasion.y - 0.03 * V)), y1 = std::min(mask.rows - 1, cvRound(nasion.y + 0.15 * V));
+        if (y1 < y0) return turn;
+        // Only the band's rows in grey: the side guide passes the camera's whole frame.
+        cv::Mat grey;
+        cv::cvtColor(bgr.rowRange(y0, y1 + 1), grey, cv::COLOR_BGR2GRAY);
         for (int y = y0; y <= y1; ++y) {
             const int edge = frontEdge(y);
             if (edge < 0) continue;
             for (int x = std::max(0, cvRound(edge - 0.30 * V)); x <= edge - cvRound(0.02 * V); ++x)
-                if (mask.at<unsigned char>(y, x)) pixels.emplace_back(grey.at<unsigned char>(y, x), (edge - x) / V);
+                if (mask.at<unsigned char>(y, x)) pixels.emplace_back(grey.at<unsigned char>(y - y0, x), (edge - x) / V);
         }
         if (pixels.size() > 50) {
             std::sort(pixels.begin(), pixels.end());
