@@ -124,10 +124,10 @@ std::vector<fs::path> writeSessionFolder(const FitOutcome& o, const SessionFolde
     PreviewSet previews;
     if (o.parts.empty()) {
         renderer.upload(o.fit.mesh, o.texture.texture);
-        previews = renderPreviews(renderer, o.fit.mesh, contents.previewSize);
+        previews = renderPreviews(renderer, o.fit.mesh, contents.previewSize, contents.previewAntialias);
     } else {
         renderer.upload(o.parts);
-        previews = renderPreviews(renderer, o.parts, contents.previewSize);
+        previews = renderPreviews(renderer, o.parts, contents.previewSize, contents.previewAntialias);
     }
     put("preview_front.png", encodeImage(previews.front, ".png"));
     put("preview_side.png", encodeImage(previews.side, ".png"));
@@ -136,7 +136,8 @@ std::vector<fs::path> writeSessionFolder(const FitOutcome& o, const SessionFolde
     if (contents.character) {
         renderer.upload(contents.character->head.mesh, contents.character->head.texture);
         put("preview_character.png", encodeImage(renderThreeQuarterPreview(renderer, contents.character->head.mesh,
-                                                                           contents.previewSize), ".png"));
+                                                                           contents.previewSize, contents.previewAntialias),
+                                                 ".png"));
     }
     const double previewSeconds = secondsSince(t1);
 

@@ -3,14 +3,13 @@
 #pragma once
 
 #include "fit/fit_pipeline.h"
+#include "render/previews.h"
 #include "reveal/character/character_outputs.h"
 
 #include <filesystem>
 #include <vector>
 
 namespace avatarbooth {
-
-class MeshRenderer;
 
 struct SessionFolderContents {
     // The photos' files, copied byte for byte into the folder; where empty (photos in memory, the kiosk), the
@@ -19,6 +18,8 @@ struct SessionFolderContents {
     // character.json and character.glb, when the character is on (null: none in the folder).
     const CharacterOutputs* character = nullptr;
     int previewSize = 512;  // the preview PNGs' side, in pixels
+    // Supersample4 with a renderer of one sample (the kiosk's writer, beside the reveal); render/previews.h.
+    Antialias previewAntialias = Antialias::Multisample;
 };
 
 // Writes `outcome` into `folder` atomically: the folder is complete (fit.json, written last, marks it) or absent,

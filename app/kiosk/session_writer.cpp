@@ -16,11 +16,12 @@ void SessionWriter::write(session::WriteFolder& job) {
     const auto t0 = std::chrono::steady_clock::now();
     try {
         // A renderer (and its GL context) for this job only: held between sessions, its buffers, texture and
-        // compiled shaders stayed resident through every attract screen and guide. Two samples and no depth target
-        // are enough for the preview PNGs.
-        MeshRenderer renderer(MeshRendererOptions{.maxSamples = 2, .depth = false});
+        // compiled shaders stayed resident through every attract screen and guide. One sample, supersampled, and no
+        // depth target: this renderer lives beside the reveal's, at the kiosk's peak of memory (render/previews.h).
+        MeshRenderer renderer(MeshRendererOptions{.maxSamples = 1, .depth = false});
         // No photo files: the photos are in memory and are written as JPEGs.
-        writeSessionFolder(*job.outcome, {{}, job.character.get(), previewSize_}, job.folder, renderer);
+        writeSessionFolder(*job.outcome, {{}, job.character.get(), previewSize_, Antialias::Supersample4}, job.folder,
+                           renderer);
     } catch (const BoothError& e) {
         done.error = e;
     } catch (const std::exception& e) {

@@ -24,10 +24,11 @@ TurntableEnded makeTurntable(const std::filesystem::path& keptFolder, const Turn
     const std::vector<AvatarPart> parts = readGlbParts(glb);  // the head, then eyes, brows, lashes, ...
     std::vector<cv::Mat> frames;
     {
-        // A renderer of its own for the job (as the session writer's): its GL context and buffers go with it.
-        MeshRenderer renderer(MeshRendererOptions{.maxSamples = 2, .depth = false});
+        // A renderer of its own for the job (as the session writer's, with one sample, supersampled): its GL context
+        // and buffers go with it.
+        MeshRenderer renderer(MeshRendererOptions{.maxSamples = 1, .depth = false});
         renderer.upload(parts);
-        frames = renderTurntable(renderer, parts, spec.size, spec.frames);
+        frames = renderTurntable(renderer, parts, spec.size, spec.frames, Antialias::Supersample4);
     }
     done.renderSeconds = since(t0);
     const auto t1 = std::chrono::steady_clock::now();

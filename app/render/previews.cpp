@@ -64,13 +64,34 @@ void checkUploaded(const MeshRenderer& renderer, const Mesh& mesh, int size) {
 
 }  // namespace
 
-PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size) {
+cv::Mat renderPicture(MeshRenderer& renderer, const RenderCamera& camera, Antialias aa) {
+    if (aa == Antialias::Multisample) return renderer.render(camera).bgr;
+    // Each pass moves the picture by (dx, dy) pixels: a translation in clip space of 2 d / size, times w so that it
+    // holds for a perspective camera too.
+    static constexpr double kOffsets[4][2] = {{0.125, 0.375}, {0.375, -0.125}, {-0.125, -0.375}, {-0.375, 0.125}};
+    cv::Mat sum;
+    for (const auto& d : kOffsets) {
+        RenderCamera shifted = camera;
+        glm::dmat4 shift(1.0);
+        shift[3][0] = 2.0 * d[0] / camera.width;
+        shift[3][1] = 2.0 * d[1] / camera.height;
+        shifted.projection = shift * camera.projection;
+        const cv::Mat bgr = renderer.render(shifted).bgr;
+        if (sum.empty()) sum = cv::Mat::zeros(bgr.size(), CV_16UC3);
+        cv::add(sum, bgr, sum, cv::noArray(), CV_16UC3);
+    }
+    cv::Mat mean;
+    sum.convertTo(mean, CV_8UC3, 0.25);  // rounds to nearest
+    return mean;
+}
+
+PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size, Antialias aa) {
     checkUploaded(renderer, mesh, size);
     const glm::dvec3 up(0.0, 1.0, 0.0);
     PreviewSet set;
-    set.front = renderer.render(framedCamera(mesh, {0.0, 0.0, 1.0}, up, size)).bgr;
-    set.side = renderer.render(framedCamera(mesh, {-1.0, 0.0, 0.0}, up, size)).bgr;
-    set.threeQuarter = renderer.render(framedCamera(mesh, threeQuarterDirection(), up, size)).bgr;
+    set.front = renderPicture(renderer, framedCamera(mesh, {0.0, 0.0, 1.0}, up, size), aa);
+    set.side = renderPicture(renderer, framedCamera(mesh, {-1.0, 0.0, 0.0}, up, size), aa);
+    set.threeQuarter = renderPicture(renderer, framedCamera(mesh, threeQuarterDirection(), up, size), aa);
     return set;
 }
 
@@ -89,15 +110,16 @@ Mesh allParts(const std::vector<AvatarPart>& parts) {
 
 }  // namespace
 
-PreviewSet renderPreviews(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size) {
-    return renderPreviews(renderer, allParts(parts), size);
+PreviewSet renderPreviews(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, Antialias aa) {
+    return renderPreviews(renderer, allParts(parts), size, aa);
 }
 
-std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames) {
-    return renderTurntable(renderer, allParts(parts), size, frames);
+std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames,
+                                     Antialias aa) {
+    return renderTurntable(renderer, allParts(parts), size, frames, aa);
 }
 
-std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames) {
+std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames, Antialias aa) {
     checkUploaded(renderer, mesh, size);
     glm::dvec3 lo, hi;
     mesh.bounds(lo, hi);
@@ -114,14 +136,14 @@ std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, i
                                                          {0.0, 1.0, 0.0}, mmPerPixel, size, size);
         camera.background = kBackground;
         camera.lit = true;
-        out.push_back(renderer.render(camera).bgr);
+        out.push_back(renderPicture(renderer, camera, aa));
     }
     return out;
 }
 
-cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size) {
+cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size, Antialias aa) {
     checkUploaded(renderer, mesh, size);
-    return renderer.render(framedCamera(mesh, threeQuarterDirection(), {0.0, 1.0, 0.0}, size)).bgr;
+    return renderPicture(renderer, framedCamera(mesh, threeQuarterDirection(), {0.0, 1.0, 0.0}, size), aa);
 }
 
 }  // namespace avatarbooth

@@ -16,6 +16,8 @@
 #include <functional>
 #include <memory>
 #include <numbers>
+#include <set>
+#include <tuple>
 #include <unistd.h>
 
 namespace avatarbooth {
@@ -591,6 +593,49 @@ TEST(RenderPreviews, ViewsAreFramedLitAndFaceTheRightWay) {
 
     const Mesh other = uvSphere(80.0, 8, 4, true);
     EXPECT_THROW(renderPreviews(renderer, other, 256), BoothError);
+}
+
+// The kiosk's background renderers draw with one sample and supersample (Antialias::Supersample4): the picture must
+// stand where the multisampled one does, with its edges as smooth, where one sample alone steps.
+TEST(RenderPreviews, SupersampledPicturesMatchTheMultisampledOnes) {
+    Mesh head = uvSphere(80.0, 32, 16, true);
+    for (auto& uv : head.uvs) uv = {1.0 / 6, 0.5};
+    addBox(head, {-10, -10, 70}, {10, 10, 105}, {3.0 / 6, 0.5});
+    cv::Mat texture(1, 3, CV_8UC3);
+    texture.at<cv::Vec3b>(0, 0) = {255, 255, 255};
+    texture.at<cv::Vec3b>(0, 1) = kRed;
+    texture.at<cv::Vec3b>(0, 2) = kGreen;
+
+    MeshRenderer multi(MeshRendererOptions{.maxSamples = 4, .depth = false});
+    MeshRenderer single(MeshRendererOptions{.maxSamples = 1, .depth = false});
+    ASSERT_EQ(single.samples(), 1);
+    if (multi.samples() < 4) GTEST_SKIP() << "the GL driver offers " << multi.samples() << " samples";
+    multi.upload(head, texture);
+    single.upload(head, texture);
+    const PreviewSet reference = renderPreviews(multi, head, 256);
+    const PreviewSet aliased = renderPreviews(single, head, 256);
+    const PreviewSet smooth = renderPreviews(single, head, 256, Antialias::Supersample4);
+    // The silhouette's edge in the reference: pixels next to both the grey ground and the sphere.
+    cv::Mat ground, body, edge;
+    for (const auto& [ref, rough, ss] : {std::tuple{&reference.front, &aliased.front, &smooth.front},
+                                         std::tuple{&reference.side, &aliased.side, &smooth.side},
+                                         std::tuple{&reference.threeQuarter, &aliased.threeQuarter, &smooth.threeQuarter}}) {
+        ASSERT_EQ(ss->size(), cv::Size(256, 256));
+        ASSERT_EQ(ss->type(), CV_8UC3);
+        cv::inRange(*ref, cv::Scalar(128, 128, 128), cv::Scalar(128, 128, 128), ground);
+        cv::dilate(ground, ground, cv::Mat::ones(3, 3, CV_8U));
+        cv::dilate(~ground, body, cv::Mat::ones(5, 5, CV_8U));
+        edge = ground & body;
+        ASSERT_GT(cv::countNonZero(edge), 300);
+        cv::Mat diffSmooth, diffRough;
+        cv::absdiff(*ss, *ref, diffSmooth);
+        cv::absdiff(*rough, *ref, diffRough);
+        // In place: no shift of the picture, which would show along every edge and the nose's.
+        EXPECT_LT(cv::mean(diffSmooth)[0], 0.5);
+        // Smooth along the silhouette as the multisampled picture is, where one sample steps.
+        const double edgeSmooth = cv::mean(diffSmooth, edge)[0], edgeRough = cv::mean(diffRough, edge)[0];
+        EXPECT_LT(edgeSmooth, 0.5 * edgeRough) << "supersampled " << edgeSmooth << ", one sample " << edgeRough;
+    }
 }
 
 }  // namespace
