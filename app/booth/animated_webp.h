@@ -4,13 +4,32 @@
 
 #include <opencv2/core.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace avatarbooth {
 
-// BGR frames of one size, shown `frameMs` each and looped forever, lossy at `quality` (0-100). Throws
-// BoothError(Internal) with libwebp's reason when encoding fails (frames of different sizes, out of memory).
+// BGR frames of width x height, added one at a time (the caller need not hold them all: 36 frames of 320 pixels are
+// 11 MB), each shown `frameMs`, looped forever, lossy at `quality` (0-100). Throws BoothError(Internal) with
+// libwebp's reason when encoding fails (a frame of another size or type, out of memory).
+class AnimatedWebpEncoder {
+public:
+    AnimatedWebpEncoder(int width, int height, int frameMs, float quality);
+    ~AnimatedWebpEncoder();
+    AnimatedWebpEncoder(const AnimatedWebpEncoder&) = delete;
+    AnimatedWebpEncoder& operator=(const AnimatedWebpEncoder&) = delete;
+
+    void add(const cv::Mat& frameBgr);
+    // The file's bytes; no frame may be added after.
+    std::string finish();
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// All of `frames` (one size, at least one) in one go.
 std::string encodeAnimatedWebp(const std::vector<cv::Mat>& frames, int frameMs, float quality);
 
 }  // namespace avatarbooth

@@ -21,20 +21,27 @@ TurntableEnded makeTurntable(const std::filesystem::path& keptFolder, const Turn
     TurntableEnded done{keptFolder, 0, 0.0, 0.0, std::nullopt};
     const auto t0 = std::chrono::steady_clock::now();
     const std::filesystem::path glb = keptFolder / "avatar.glb";
-    const std::vector<AvatarPart> parts = readGlbParts(glb);  // the head, then eyes, brows, lashes, ...
-    std::vector<cv::Mat> frames;
+    std::vector<AvatarPart> parts = readGlbParts(glb);  // the head, then eyes, brows, lashes, ...
+    AnimatedWebpEncoder encoder(spec.size, spec.size, spec.frameMs, spec.quality);
     {
         // A renderer of its own for the job (as the session writer's, with one sample, supersampled): its GL context
-        // and buffers go with it.
-        MeshRenderer renderer(MeshRendererOptions{.maxSamples = 1, .depth = false});
+        // and buffers go with it. This runs beside the reveal: textures finer than twice the frame are scaled down,
+        // the parts' own copies are let go once uploaded (the framing needs their meshes only), and each frame is
+        // encoded as it comes.
+        MeshRenderer renderer(MeshRendererOptions{.maxSamples = 1, .depth = false, .maxTextureSize = 2 * spec.size});
         renderer.upload(parts);
-        frames = renderTurntable(renderer, parts, spec.size, spec.frames, Antialias::Supersample4);
+        for (AvatarPart& part : parts) part.texture.release();
+        renderTurntable(renderer, parts, spec.size, spec.frames, Antialias::Supersample4, [&](const cv::Mat& frame) {
+            const auto t = std::chrono::steady_clock::now();
+            encoder.add(frame);
+            done.encodeSeconds += since(t);
+        });
     }
-    done.renderSeconds = since(t0);
+    done.renderSeconds = since(t0) - done.encodeSeconds;
     const auto t1 = std::chrono::steady_clock::now();
-    const std::string webp = encodeAnimatedWebp(frames, spec.frameMs, spec.quality);
+    const std::string webp = encoder.finish();
     writeFileAtomically(keptFolder / "turntable.webp", webp);
-    done.encodeSeconds = since(t1);
+    done.encodeSeconds += since(t1);
     done.bytes = webp.size();
     return done;
 }

@@ -119,7 +119,10 @@ std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const std::vector<A
     return renderTurntable(renderer, allParts(parts), size, frames, aa);
 }
 
-std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames, Antialias aa) {
+namespace {
+
+void turntableFrames(MeshRenderer& renderer, const Mesh& mesh, int size, int frames, Antialias aa,
+                     const std::function<void(const cv::Mat&)>& each) {
     checkUploaded(renderer, mesh, size);
     glm::dvec3 lo, hi;
     mesh.bounds(lo, hi);
@@ -128,7 +131,6 @@ std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, i
     for (const auto& p : mesh.positions) radius = std::max(radius, glm::length(p - centre));
     const double mmPerPixel = 2.0 * radius * (1.0 + 2.0 * kMargin) / size;
     const double elevation = glm::radians(10.0);
-    std::vector<cv::Mat> out;
     for (int i = 0; i < frames; ++i) {
         const double a = 2.0 * 3.14159265358979323846 * i / frames;
         const glm::dvec3 back(-std::sin(a) * std::cos(elevation), std::sin(elevation), std::cos(a) * std::cos(elevation));
@@ -136,8 +138,20 @@ std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, i
                                                          {0.0, 1.0, 0.0}, mmPerPixel, size, size);
         camera.background = kBackground;
         camera.lit = true;
-        out.push_back(renderPicture(renderer, camera, aa));
+        each(renderPicture(renderer, camera, aa));
     }
+}
+
+}  // namespace
+
+void renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames, Antialias aa,
+                     const std::function<void(const cv::Mat&)>& each) {
+    turntableFrames(renderer, allParts(parts), size, frames, aa, each);
+}
+
+std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames, Antialias aa) {
+    std::vector<cv::Mat> out;
+    turntableFrames(renderer, mesh, size, frames, aa, [&](const cv::Mat& frame) { out.push_back(frame); });
     return out;
 }
 

@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <functional>
 #include <vector>
 
 namespace avatarbooth {
@@ -49,5 +50,8 @@ std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, i
 // The same of the avatar's parts (all uploaded with MeshRenderer::upload(parts)), at the scale of them all.
 std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames,
                                      Antialias aa = Antialias::Multisample);
+// The same, each frame handed to `each` as soon as it is drawn, none kept (the kiosk encodes them as they come).
+void renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames, Antialias aa,
+                     const std::function<void(const cv::Mat&)>& each);
 
 }  // namespace avatarbooth

@@ -231,6 +231,9 @@ namespace {
 
 // How far the per-frame window may slide over the noise field: this many distinct noise frames.
 constexpr std::size_t kNoiseOffsets = 1 << 16;
+// The field covers a quarter of a frame; each quarter of a frame takes it from its own offset (the two tables of a
+// whole frame's were 4 MB of the simulated booth's peak memory).
+constexpr std::size_t kNoiseParts = 4;
 
 std::uint64_t splitmix(std::uint64_t x) {
     x += 0x9E3779B97F4A7C15ull;
@@ -244,7 +247,7 @@ std::uint64_t splitmix(std::uint64_t x) {
 SensorNoise::SensorNoise(std::size_t frameBytes, std::uint64_t seed, int amplitude) : frameBytes_(frameBytes) {
     if (amplitude <= 0 || frameBytes == 0) return;
     amplitude = std::min(amplitude, 50);
-    plus_.resize(frameBytes + kNoiseOffsets);
+    plus_.resize((frameBytes + kNoiseParts - 1) / kNoiseParts + kNoiseOffsets);
     minus_.resize(plus_.size());
     const auto span = static_cast<std::uint64_t>(2 * amplitude + 1);
     std::uint64_t state = seed;
@@ -258,11 +261,16 @@ SensorNoise::SensorNoise(std::size_t frameBytes, std::uint64_t seed, int amplitu
 void SensorNoise::apply(cv::Mat& image, std::uint64_t frameSeed) const {
     if (plus_.empty()) return;
     CV_Assert(image.isContinuous() && image.depth() == CV_8U && image.total() * image.elemSize() == frameBytes_);
-    const auto offset = static_cast<std::size_t>(splitmix(frameSeed) % kNoiseOffsets);
     cv::Mat flat = image.reshape(1, 1);
-    const int n = static_cast<int>(frameBytes_);
-    cv::add(flat, cv::Mat(1, n, CV_8UC1, const_cast<std::uint8_t*>(plus_.data() + offset)), flat);
-    cv::subtract(flat, cv::Mat(1, n, CV_8UC1, const_cast<std::uint8_t*>(minus_.data() + offset)), flat);
+    const std::size_t part = (frameBytes_ + kNoiseParts - 1) / kNoiseParts;
+    std::uint64_t state = splitmix(frameSeed);
+    for (std::size_t from = 0; from < frameBytes_; from += part) {
+        const auto offset = static_cast<std::size_t>(splitmix(state++) % kNoiseOffsets);
+        const int n = static_cast<int>(std::min(part, frameBytes_ - from));
+        cv::Mat piece = flat.colRange(static_cast<int>(from), static_cast<int>(from) + n);
+        cv::add(piece, cv::Mat(1, n, CV_8UC1, const_cast<std::uint8_t*>(plus_.data() + offset)), piece);
+        cv::subtract(piece, cv::Mat(1, n, CV_8UC1, const_cast<std::uint8_t*>(minus_.data() + offset)), piece);
+    }
 }
 
 }  // namespace avatarbooth

@@ -59,9 +59,9 @@ private:
 };
 
 // Sensor noise for preview frames: +-amplitude grey levels on every byte, different for every frame and
-// reproducible from a seed. A noise field slightly larger than a frame is drawn once; each frame takes it from a
-// per-frame offset and applies it with two saturating SIMD passes (add the positive part, subtract the negative
-// part), about a millisecond at 1280x720 here.
+// reproducible from a seed. A noise field slightly larger than a quarter of a frame is drawn once; each quarter of
+// each frame takes it from an offset of its own and applies it with two saturating SIMD passes (add the positive
+// part, subtract the negative part), about a millisecond at 1280x720 here.
 class SensorNoise {
 public:
     SensorNoise() = default;
