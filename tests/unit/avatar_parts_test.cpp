@@ -81,6 +81,25 @@ TEST(HeadProxyFiles, RoundTripAndClearErrors) {
     ASSERT_EQ(back.texture.type(), CV_8UC4);
     EXPECT_EQ(back.texture.at<cv::Vec4b>(1, 1), cv::Vec4b(10, 20, 30, 128));
     EXPECT_EQ(cv::countNonZero(back.tintMask), 16);
+    // Held encoded (a hair style waiting to be chosen), the pixels are let go and come back the same.
+    HeadProxy waiting = back;
+    holdEncoded(waiting);
+    EXPECT_TRUE(waiting.texture.empty());
+    EXPECT_TRUE(waiting.tintMask.empty());
+    const auto [texture, tintMask] = proxyPixels(waiting);
+    ASSERT_EQ(texture.type(), CV_8UC4);
+    ASSERT_EQ(tintMask.type(), CV_8U);
+    EXPECT_EQ(cv::norm(texture, back.texture, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(tintMask, back.tintMask, cv::NORM_INF), 0.0);
+    // Bytes that no longer decode name the proxy.
+    waiting.encodedTexture = "not a PNG";
+    try {
+        proxyPixels(waiting);
+        FAIL() << "no error";
+    } catch (const BoothError& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::BadConfig);
+        EXPECT_NE(std::string(e.what()).find("does not decode"), std::string::npos) << e.what();
+    }
     // A binding past a smaller head names the file and the field.
     try {
         loadHeadProxy(dir / file, {{0, 0, 0}, {1, 0, 0}});

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 
 namespace avatarbooth {
 
@@ -181,6 +182,13 @@ BaseHead loadBaseHead(const std::filesystem::path& meshGlb, const std::filesyste
             if (!name.is_string()) throw BoothError(ErrorKind::BadConfig, where, "field 'proxies' must be a list of file names");
             head.proxies.push_back(loadHeadProxy(featureJson.parent_path() / name.get<std::string>(), head.mesh.positions));
         }
+        // A part several proxies make (the hair styles) is placed from one of them per fit: the others' pixels wait
+        // encoded.
+        std::map<std::string, int> makers;
+        for (const HeadProxy& p : head.proxies) ++makers[p.name];
+        for (HeadProxy& p : head.proxies)
+            if (makers[p.name] > 1) holdEncoded(p);
+            else p.encodedTexture.clear(), p.encodedTintMask.clear();
     }
     head.frontContour = findContourVertices(head.mesh, head.eyeMidpoint(), 0, defaultFrontContourAngles());
     head.sideContour = findContourVertices(head.mesh, head.earHoleCentre, 1, defaultSideContourAngles());

@@ -114,7 +114,8 @@ AvatarPart placeProxyPart(const HeadProxy& proxy, const Mesh& fittedHead, const 
     part.mesh.positions = placeProxy(proxy.binding, fittedHead.positions);
     part.mesh.uvs = proxy.mesh.uvs;
     part.mesh.triangles = proxy.mesh.triangles;
-    part.texture = colour != nullptr && !proxy.tintMask.empty() ? tintTexture(proxy.texture, proxy.tintMask, *colour) : proxy.texture;
+    const auto [texture, tintMask] = proxyPixels(proxy);
+    part.texture = colour != nullptr && !tintMask.empty() ? tintTexture(texture, tintMask, *colour) : texture;
     part.alpha = proxy.alpha;
     part.alphaCutoff = proxy.alphaCutoff;
     return part;

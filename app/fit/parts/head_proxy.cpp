@@ -3,6 +3,8 @@
 
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/file_bytes.h"
+#include "common/image_codec.h"
 #include "common/image_io.h"
 
 #include <nlohmann/json.hpp>
@@ -97,6 +99,58 @@ std::string saveHeadProxy(const HeadProxy& p, const fs::path& dir) {
     return file;
 }
 
+namespace {
+
+PhotoLimits textureLimits() {
+    PhotoLimits limits;
+    limits.minSide = 1;  // a texture may be small; the photos' lower limit is for faces
+    return limits;
+}
+const PhotoLimits kTextureLimits = textureLimits();
+
+// The texture as the alpha mode wants it, the tint mask as one channel, and their sizes checked.
+void finishPixels(HeadProxy& p, const std::string& where) {
+    if (p.alpha == AlphaMode::Opaque) cv::cvtColor(p.texture, p.texture, cv::COLOR_BGRA2BGR);
+    if (!p.tintMask.empty()) {
+        cv::Mat one;
+        cv::extractChannel(p.tintMask, one, 0);
+        p.tintMask = one;
+        if (p.tintMask.size() != p.texture.size())
+            throw BoothError(ErrorKind::BadConfig, where, "its tint mask and texture differ in size");
+    }
+}
+
+cv::Mat decodeChecked(const std::string& bytes, bool alpha, const std::string& where) {
+    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+    cv::Mat image;
+    try {
+        image = alpha ? decodeImageWithAlpha(data, bytes.size()) : decodeImage(data, bytes.size());
+    } catch (const std::exception& e) {
+        throw BoothError(ErrorKind::BadConfig, where, std::string("its texture does not decode: ") + e.what());
+    }
+    if (image.empty()) throw BoothError(ErrorKind::BadConfig, where, "its texture does not decode");
+    return image;
+}
+
+}  // namespace
+
+std::pair<cv::Mat, cv::Mat> proxyPixels(const HeadProxy& proxy) {
+    if (!proxy.texture.empty() || proxy.encodedTexture.empty()) return {proxy.texture, proxy.tintMask};
+    HeadProxy p;
+    p.alpha = proxy.alpha;
+    const std::string where = "head proxy " + proxy.source;
+    p.texture = decodeChecked(proxy.encodedTexture, true, where);
+    if (!proxy.encodedTintMask.empty()) p.tintMask = decodeChecked(proxy.encodedTintMask, false, where);
+    finishPixels(p, where);
+    return {p.texture, p.tintMask};
+}
+
+void holdEncoded(HeadProxy& proxy) {
+    if (proxy.encodedTexture.empty() || (!proxy.tintMask.empty() && proxy.encodedTintMask.empty())) return;
+    proxy.texture.release();
+    proxy.tintMask.release();
+}
+
 HeadProxy loadHeadProxy(const fs::path& file, const std::vector<glm::dvec3>& head) {
     const std::string where = file.string();
     std::ifstream in(file);
@@ -152,16 +206,16 @@ HeadProxy loadHeadProxy(const fs::path& file, const std::vector<glm::dvec3>& hea
                 throw BoothError(ErrorKind::BadConfig, where, "field 'replaces' refers past the base head's vertices");
             p.replaces.push_back(v.get<std::uint32_t>());
         }
-        PhotoLimits textureLimits;
-        textureLimits.minSide = 1;  // a texture may be small; the photos' lower limit is for faces
-        p.texture = readImageWithAlpha(file.parent_path() / field("texture").get<std::string>(), textureLimits);
-        if (p.alpha == AlphaMode::Opaque) cv::cvtColor(p.texture, p.texture, cv::COLOR_BGRA2BGR);
+        // Read (and checked) here; the bytes are kept too, for holdEncoded.
+        const fs::path textureFile = file.parent_path() / field("texture").get<std::string>();
+        p.texture = readImageWithAlpha(textureFile, kTextureLimits);
+        p.encodedTexture = readFileBytes(textureFile);
         if (j.contains("tint_mask")) {
-            cv::Mat mask = readPhoto(file.parent_path() / j["tint_mask"].get<std::string>(), textureLimits);
-            cv::extractChannel(mask, p.tintMask, 0);
-            if (p.tintMask.size() != p.texture.size())
-                throw BoothError(ErrorKind::BadConfig, where, "its tint mask and texture differ in size");
+            const fs::path maskFile = file.parent_path() / j["tint_mask"].get<std::string>();
+            p.tintMask = readPhoto(maskFile, kTextureLimits);
+            p.encodedTintMask = readFileBytes(maskFile);
         }
+        finishPixels(p, where);
     } catch (const nlohmann::json::exception& e) {
         throw BoothError(ErrorKind::BadConfig, where, std::string("not a head proxy as expected: ") + e.what());
     }

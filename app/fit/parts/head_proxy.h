@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace avatarbooth {
@@ -46,7 +47,17 @@ struct HeadProxy {
     cv::Mat tintMask;
     // Base-head vertices whose triangles this part replaces in the head part (the eyes: hm08's own eyeballs).
     std::vector<std::uint32_t> replaces;
+    // A proxy that is one of several alternatives for its part (the hair styles, of which a fit places one) may hold
+    // its texture and tint mask encoded instead (their files' bytes, texture and tintMask then empty): the four
+    // styles' pixels were 5 MB of the kiosk's memory from start-up on. proxyPixels() decodes them.
+    std::string encodedTexture, encodedTintMask;
 };
+
+// The proxy's texture and tint mask as pixels: its own, or those it holds encoded, decoded (as loadHeadProxy reads
+// them). Throws BoothError(BadConfig) naming the proxy when they no longer decode.
+std::pair<cv::Mat, cv::Mat> proxyPixels(const HeadProxy& proxy);
+// Lets go of the proxy's pixels, keeping their encoded bytes (which loadHeadProxy keeps for this).
+void holdEncoded(HeadProxy& proxy);
 
 // Writes NAME.json (binding, triangles, UVs, alpha, replaced vertices), NAME.png (texture) and, when there is one,
 // NAME.tint.png into `dir`, NAME being the part's name and the source's folder (eyes_HighPolyEyes; several
