@@ -88,11 +88,12 @@ FitPipeline::FitPipeline(FitSettings settings, const BaseHead& base) : settings_
     detector_ = std::make_unique<LandmarkDetector>(settings_.landmarkModel);
     textureTables_ = std::make_shared<const TextureTables>(base_.mesh, settings_.texture, base_.skin);
     frontalCheck_ = std::make_shared<FrontalFaceCheck>();
+    modelLoadSeconds_ = secondsSince(t0);
     // OpenCV fills its 8-bit CIELAB tables at the first such conversion (0.13 s of one core here), which the hair
-    // analysis makes: here, while the kiosk's attract screen runs, not in the first visitor's fit.
+    // analysis makes: here, while the kiosk's attract screen runs, not in the first visitor's fit (and not counted
+    // as the model's loading, which it is not).
     cv::Mat lab;
     cv::cvtColor(cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(128)), lab, cv::COLOR_BGR2Lab);
-    modelLoadSeconds_ = secondsSince(t0);
 }
 
 FitPipeline::FitPipeline(const FitPipeline& shareFrom, std::unique_ptr<LandmarkDetector> detector)
