@@ -288,7 +288,7 @@ HairEstimate estimateHair(const HairPhotos& photos, const HairOptions& options) 
     // window alone); a bob beside the face down to the jaw. The side's windows sit where hoods and collars
     // often are, so the front decides where it can.
     if (!a.hair || e.crown < options.bald) out.style = HairStyle::None;
-    else if (e.belowChin > options.long_) out.style = HairStyle::Long;
+    else if (e.belowChin > options.long_ && e.besideFace > options.longBeside) out.style = HairStyle::Long;
     else if (e.besideFace > options.beside) out.style = HairStyle::Bob;
     else if (e.downTheBack > options.ponytail && e.behindHead > options.ponytail) out.style = HairStyle::Ponytail;
     else out.style = HairStyle::Short;

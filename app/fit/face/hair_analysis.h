@@ -72,6 +72,10 @@ struct HairPhotos {
 struct HairOptions {
     double bald = 0.3;           // crown share under this: no hair
     double long_ = 0.15;         // belowChin over this: the hair falls past the chin beside the neck
+    // ... and besideFace over this: on its way down, long hair lies beside the face too (FRMDB's long hair 0.19-1.00
+    // there); under a bald crown, whose shading reads as hair of the skin's colour, skin beside the neck reached
+    // the long threshold with nothing beside the jaw (0.00-0.04: HairPopulation's people 13 and 17).
+    double longBeside = 0.1;
     double beside = 0.2;         // besideFace over this (not long): a bob
     double ponytail = 0.3;       // downTheBack and behindHead over this (nothing beside the face or neck): a ponytail
     double beardDarkening = 14.0;   // chin (and jaw at 0.5 of it) L* under the cheeks' by this much: a beard
