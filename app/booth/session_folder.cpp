@@ -81,6 +81,22 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
     report["residuals"] = residuals;
     report["residual_rms_mm"] = o.fit.residuals.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(o.fit.residuals.size()));
     report["residual_max_mm"] = worst;
+    {
+        // What the hair analysis chose and the evidence it chose by (fit/face/hair_analysis.h): the operator's way to
+        // see why a visitor got the hair the avatar wears.
+        const HairEstimate& h = o.hair;
+        const HairEvidence& e = h.evidence;
+        const auto bgr = [](const cv::Vec3d& c) { return nlohmann::json{c[0], c[1], c[2]}; };
+        report["hair"] = {{"style", toString(h.style)},
+                          {"colour_bgr", bgr(h.colour)},
+                          {"skin_bgr", bgr(h.skinColour)},
+                          {"beard", h.beard},
+                          {"moustache", h.moustache},
+                          {"evidence", {{"crown", e.crown}, {"hair_from_skin", e.hairFromSkin}, {"beside_face", e.besideFace},
+                                        {"below_chin", e.belowChin}, {"behind_head", e.behindHead},
+                                        {"down_the_back", e.downTheBack}, {"chin_darkening", e.chinDarkening},
+                                        {"upper_lip_darkening", e.upperLipDarkening}, {"jaw_darkening", e.jawDarkening}}}};
+    }
     if (!o.fit.modifierWeights.empty()) {
         // The first fitting step: the MakeHuman modifiers it used, and the targets' RMS before and after it.
         nlohmann::json modifiers = nlohmann::json::object();

@@ -3,6 +3,7 @@
 #include "run_binary.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -81,6 +82,16 @@ TEST(FitCli, WritesACompleteSessionFolderWithAValidGlb) {
     for (const char* node : {"\"name\":\"head\"", "\"name\":\"eyes\"", "\"name\":\"eyebrows\"", "\"name\":\"eyelashes\"",
                              "\"alphaMode\":\"BLEND\"", "\"alphaMode\":\"MASK\""})
         EXPECT_NE(json.find(node), std::string::npos) << node;
+    // fit.json says which hair the analysis chose and by what; the avatar wears that hair (a "hair" part) or none.
+    const nlohmann::json fitJson = nlohmann::json::parse(readBytes(out / "fit.json"));
+    ASSERT_TRUE(fitJson.contains("hair")) << fitJson.dump(1);
+    const std::string style = fitJson["hair"]["style"].get<std::string>();
+    EXPECT_TRUE(style == "none" || style == "short" || style == "bob" || style == "long" || style == "ponytail") << style;
+    EXPECT_EQ(json.find("\"name\":\"hair\"") != std::string::npos, style != "none") << style;
+    const double crown = fitJson["hair"]["evidence"]["crown"].get<double>();
+    EXPECT_GE(crown, 0.0);
+    EXPECT_LE(crown, 1.0);
+    EXPECT_EQ(fitJson["hair"]["colour_bgr"].size(), 3u);
     // The previews show a head, not an empty grey square.
     const cv::Mat preview = cv::imread((out / "preview_front.png").string());
     ASSERT_FALSE(preview.empty());
