@@ -14,8 +14,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-[[noreturn]] void bad(const fs::path& path, const std::string& why) {
-    throw BoothError(ErrorKind::BadInput, path.string(), why);
+[[noreturn]] void bad(const std::string& where, const std::string& why) {
+    throw BoothError(ErrorKind::BadInput, where, why);
 }
 
 }  // namespace
@@ -30,10 +30,7 @@ std::string encodeImage(const cv::Mat& image, const std::string& ext, int jpegQu
     throw BoothError(ErrorKind::Internal, "", "could not encode an image as " + ext + " (only .jpg and .png are written)");
 }
 
-namespace {
-
-cv::Mat readChecked(const fs::path& path, const PhotoLimits& limits, bool alpha) {
-    const std::string file = readFileBytes(path);
+cv::Mat decodeCheckedImage(const std::string& file, const std::string& path, const PhotoLimits& limits, bool alpha) {
     if (file.empty()) bad(path, "is empty (0 bytes)");
     const std::span<const unsigned char> bytes(reinterpret_cast<const unsigned char*>(file.data()), file.size());
 
@@ -78,10 +75,12 @@ cv::Mat readChecked(const fs::path& path, const PhotoLimits& limits, bool alpha)
     return image;
 }
 
-}  // namespace
+cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) {
+    return decodeCheckedImage(readFileBytes(path), path.string(), limits, false);
+}
 
-cv::Mat readPhoto(const fs::path& path, const PhotoLimits& limits) { return readChecked(path, limits, false); }
-
-cv::Mat readImageWithAlpha(const fs::path& path, const PhotoLimits& limits) { return readChecked(path, limits, true); }
+cv::Mat readImageWithAlpha(const fs::path& path, const PhotoLimits& limits) {
+    return decodeCheckedImage(readFileBytes(path), path.string(), limits, true);
+}
 
 }  // namespace avatarbooth

@@ -22,5 +22,8 @@ std::string encodeImage(const cv::Mat& image, const std::string& ext, int jpegQu
 cv::Mat readPhoto(const std::filesystem::path& path, const PhotoLimits& limits = {});
 // The same checks, read as 8-bit BGRA (a PNG's alpha kept; other images opaque): textures with transparency.
 cv::Mat readImageWithAlpha(const std::filesystem::path& path, const PhotoLimits& limits = {});
+// The same checks and decoding of a file's bytes already in memory (`where` names them in the error): as
+// readImageWithAlpha when `keepAlpha`, else as readPhoto.
+cv::Mat decodeCheckedImage(const std::string& bytes, const std::string& where, const PhotoLimits& limits, bool keepAlpha);
 
 }  // namespace avatarbooth

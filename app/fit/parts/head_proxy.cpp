@@ -4,7 +4,6 @@
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/file_bytes.h"
-#include "common/image_codec.h"
 #include "common/image_io.h"
 
 #include <nlohmann/json.hpp>
@@ -120,16 +119,13 @@ void finishPixels(HeadProxy& p, const std::string& where) {
     }
 }
 
-cv::Mat decodeChecked(const std::string& bytes, bool alpha, const std::string& where) {
-    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-    cv::Mat image;
+// Bytes loadHeadProxy read and checked once, decoded again when the proxy is placed.
+cv::Mat decodeHeld(const std::string& bytes, bool alpha, const std::string& where) {
     try {
-        image = alpha ? decodeImageWithAlpha(data, bytes.size()) : decodeImage(data, bytes.size());
-    } catch (const std::exception& e) {
+        return decodeCheckedImage(bytes, where, kTextureLimits, alpha);
+    } catch (const BoothError& e) {
         throw BoothError(ErrorKind::BadConfig, where, std::string("its texture does not decode: ") + e.what());
     }
-    if (image.empty()) throw BoothError(ErrorKind::BadConfig, where, "its texture does not decode");
-    return image;
 }
 
 }  // namespace
@@ -139,8 +135,8 @@ std::pair<cv::Mat, cv::Mat> proxyPixels(const HeadProxy& proxy) {
     HeadProxy p;
     p.alpha = proxy.alpha;
     const std::string where = "head proxy " + proxy.source;
-    p.texture = decodeChecked(proxy.encodedTexture, true, where);
-    if (!proxy.encodedTintMask.empty()) p.tintMask = decodeChecked(proxy.encodedTintMask, false, where);
+    p.texture = decodeHeld(proxy.encodedTexture, true, where);
+    if (!proxy.encodedTintMask.empty()) p.tintMask = decodeHeld(proxy.encodedTintMask, false, where);
     finishPixels(p, where);
     return {p.texture, p.tintMask};
 }
@@ -206,14 +202,14 @@ HeadProxy loadHeadProxy(const fs::path& file, const std::vector<glm::dvec3>& hea
                 throw BoothError(ErrorKind::BadConfig, where, "field 'replaces' refers past the base head's vertices");
             p.replaces.push_back(v.get<std::uint32_t>());
         }
-        // Read (and checked) here; the bytes are kept too, for holdEncoded.
+        // Each file read once and checked; its bytes are kept too, for holdEncoded.
         const fs::path textureFile = file.parent_path() / field("texture").get<std::string>();
-        p.texture = readImageWithAlpha(textureFile, kTextureLimits);
         p.encodedTexture = readFileBytes(textureFile);
+        p.texture = decodeCheckedImage(p.encodedTexture, textureFile.string(), kTextureLimits, true);
         if (j.contains("tint_mask")) {
             const fs::path maskFile = file.parent_path() / j["tint_mask"].get<std::string>();
-            p.tintMask = readPhoto(maskFile, kTextureLimits);
             p.encodedTintMask = readFileBytes(maskFile);
+            p.tintMask = decodeCheckedImage(p.encodedTintMask, maskFile.string(), kTextureLimits, false);
         }
         finishPixels(p, where);
     } catch (const nlohmann::json::exception& e) {
