@@ -66,11 +66,4 @@ std::string AnimatedWebpEncoder::finish() {
     return bytes;
 }
 
-std::string encodeAnimatedWebp(const std::vector<cv::Mat>& frames, int frameMs, float quality) {
-    if (frames.empty()) throw BoothError(ErrorKind::Internal, "", "animated WebP: no frames");
-    AnimatedWebpEncoder encoder(frames.front().cols, frames.front().rows, frameMs, quality);
-    for (const cv::Mat& frame : frames) encoder.add(frame);
-    return encoder.finish();
-}
-
 }  // namespace avatarbooth

@@ -6,7 +6,6 @@
 
 #include <memory>
 #include <string>
-#include <vector>
 
 namespace avatarbooth {
 
@@ -28,8 +27,5 @@ private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
-
-// All of `frames` (one size, at least one) in one go.
-std::string encodeAnimatedWebp(const std::vector<cv::Mat>& frames, int frameMs, float quality);
 
 }  // namespace avatarbooth

@@ -62,8 +62,7 @@ void checkUploaded(const MeshRenderer& renderer, const Mesh& mesh, int size) {
     if (size <= 0) throw BoothError(ErrorKind::Internal, "", "previews: size must be positive");
 }
 
-}  // namespace
-
+// One view's colour picture, anti-aliased as asked.
 cv::Mat renderPicture(MeshRenderer& renderer, const RenderCamera& camera, Antialias aa) {
     if (aa == Antialias::Multisample) return renderer.render(camera).bgr;
     // Each pass moves the picture by (dx, dy) pixels: a translation in clip space of 2 d / size, times w so that it
@@ -84,6 +83,8 @@ cv::Mat renderPicture(MeshRenderer& renderer, const RenderCamera& camera, Antial
     sum.convertTo(mean, CV_8UC3, 0.25);  // rounds to nearest
     return mean;
 }
+
+}  // namespace
 
 PreviewSet renderPreviews(MeshRenderer& renderer, const Mesh& mesh, int size, Antialias aa) {
     checkUploaded(renderer, mesh, size);
@@ -114,15 +115,9 @@ PreviewSet renderPreviews(MeshRenderer& renderer, const std::vector<AvatarPart>&
     return renderPreviews(renderer, allParts(parts), size, aa);
 }
 
-std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames,
-                                     Antialias aa) {
-    return renderTurntable(renderer, allParts(parts), size, frames, aa);
-}
-
-namespace {
-
-void turntableFrames(MeshRenderer& renderer, const Mesh& mesh, int size, int frames, Antialias aa,
+void renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames, Antialias aa,
                      const std::function<void(const cv::Mat&)>& each) {
+    const Mesh mesh = allParts(parts);
     checkUploaded(renderer, mesh, size);
     glm::dvec3 lo, hi;
     mesh.bounds(lo, hi);
@@ -140,19 +135,6 @@ void turntableFrames(MeshRenderer& renderer, const Mesh& mesh, int size, int fra
         camera.lit = true;
         each(renderPicture(renderer, camera, aa));
     }
-}
-
-}  // namespace
-
-void renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames, Antialias aa,
-                     const std::function<void(const cv::Mat&)>& each) {
-    turntableFrames(renderer, allParts(parts), size, frames, aa, each);
-}
-
-std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames, Antialias aa) {
-    std::vector<cv::Mat> out;
-    turntableFrames(renderer, mesh, size, frames, aa, [&](const cv::Mat& frame) { out.push_back(frame); });
-    return out;
 }
 
 cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size, Antialias aa) {

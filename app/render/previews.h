@@ -38,19 +38,11 @@ PreviewSet renderPreviews(MeshRenderer& renderer, const std::vector<AvatarPart>&
 cv::Mat renderThreeQuarterPreview(MeshRenderer& renderer, const Mesh& mesh, int size = 512,
                                   Antialias aa = Antialias::Multisample);
 
-// One render's colour picture, anti-aliased as asked (the previews' and the turntable's each view).
-cv::Mat renderPicture(MeshRenderer& renderer, const RenderCamera& camera, Antialias aa);
-
-// `frames` views of the mesh turning once about its vertical axis (the first from the front, then towards the
-// subject's left), seen from slightly above, all at one scale (the mesh's bounding sphere fills the square, so the
-// head neither grows nor shrinks as it turns): lit, square (size x size, BGR), on the previews' grey. The same
-// checks as renderPreviews.
-std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const Mesh& mesh, int size, int frames,
-                                     Antialias aa = Antialias::Multisample);
-// The same of the avatar's parts (all uploaded with MeshRenderer::upload(parts)), at the scale of them all.
-std::vector<cv::Mat> renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames,
-                                     Antialias aa = Antialias::Multisample);
-// The same, each frame handed to `each` as soon as it is drawn, none kept (the kiosk encodes them as they come).
+// `frames` views of the avatar's parts (all uploaded with MeshRenderer::upload(parts)) turning once about their
+// vertical axis (the first from the front, then towards the subject's left), seen from slightly above, all at one
+// scale (their bounding sphere fills the square, so the head neither grows nor shrinks as it turns): lit, square
+// (size x size, BGR), on the previews' grey, each handed to `each` as soon as it is drawn, none kept (the kiosk
+// encodes them as they come). The same checks as renderPreviews.
 void renderTurntable(MeshRenderer& renderer, const std::vector<AvatarPart>& parts, int size, int frames, Antialias aa,
                      const std::function<void(const cv::Mat&)>& each);
 
