@@ -8,7 +8,9 @@
 # Then the trixie stage: the build and the tests in a Debian 13 root, the kernel tests of the gpiod 2 and
 # libcamera 0.4 builds in the guest, the .deb installed there (tests/trixie/run.sh). AVATARBOOTH_TRIXIE=0/1 likewise.
 # CI's budget is 45 minutes for all of it on a fresh 2-core machine; the README ("Building for the board") has the
-# measured figures of each phase. Each phase prints its time ("run: ... took N s").
+# measured figures of each phase. Each phase prints its time ("run: ... took N s"). To fit the budget the later
+# stages' downloads run beside the native build (tests/prepare_stages.sh), and their builds beside the native tests
+# at idle priority (below).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 preset="${1:-release}"
@@ -19,17 +21,58 @@ arm64="${AVATARBOOTH_ARM64:-$arm64_default}"
 trixie="${AVATARBOOTH_TRIXIE:-$arm64_default}"
 
 start=$SECONDS
+# The packages first; then the later stages' downloads (tests/prepare_stages.sh) run beside the native build.
+"$root/tests/setup.sh" --install-only
+prepare_log="$root/build/$preset/prepare"
+# set -m: a background job in a process group of its own, so that one kill stops it and all it started.
+set -m
+"$root/tests/prepare_stages.sh" "$root/build/$preset/kernel-guest" "$arm64" "$trixie" "$prepare_log" &
+prepare_pid=$!
+set +m
+trap 'kill -- -$prepare_pid 2>/dev/null || true' EXIT  # a failed build leaves no download behind
 "$root/tests/setup.sh" "$preset"
+build_done=$SECONDS
+wait "$prepare_pid" || true
+trap - EXIT
 setup_done=$SECONDS
-echo "run: set-up and native build took $((setup_done - start)) s"
+echo "run: set-up and native build took $((build_done - start)) s, then $((setup_done - build_done)) s waiting for the later stages' set-ups (logs in $prepare_log)"
 
 # Headless EGL through Mesa (llvmpipe) needs no display; keep Mesa from looking for one.
 export EGL_PLATFORM=surfaceless
 # No `exit` on failure before the arm64 and trixie stages: CI reports all, and fails if any failed.
 rc=0
+# The later stages' builds start beside the native tests at SCHED_IDLE (chrt --idle): a compiler then runs only on
+# a core no test wants (a test that wakes takes the core back at once), and many tests wait on the kiosk's clock, a
+# browser or the guest. What is not built when the tests end is killed (make deletes what it was writing) and the
+# stage builds it at normal priority.
+early_log="$root/build/$preset/early-builds.log"
+early_pid=""
+if [ "$arm64" = 1 ] || [ "$trixie" = 1 ]; then
+  set -m
+  chrt --idle 0 bash -c '
+    if [ "$1" = 1 ]; then "$3/tests/arm64/run.sh" --build-only || echo "early builds: arm64 failed (exit $?)"; fi
+    if [ "$2" = 1 ]; then "$3/tests/trixie/run.sh" --build-only || echo "early builds: trixie failed (exit $?)"; fi
+    echo "early builds: finished"
+  ' early_builds "$arm64" "$trixie" "$root" >"$early_log" 2>&1 &
+  early_pid=$!
+  set +m
+  trap 'kill -- -$early_pid 2>/dev/null || true' EXIT
+fi
 ctest --preset "$preset" --timeout 900 --parallel "$(nproc)" "$@" || rc=$?
 tests_done=$SECONDS
 echo "run: native tests took $((tests_done - setup_done)) s"
+if [ -n "$early_pid" ]; then
+  if kill -0 "$early_pid" 2>/dev/null; then
+    kill -TERM -- "-$early_pid" 2>/dev/null || true
+    wait "$early_pid" 2>/dev/null || true
+    echo "run: the later stages' builds ran beside the native tests, unfinished (log: $early_log):"
+  else
+    wait "$early_pid" 2>/dev/null || true
+    echo "run: the later stages' builds ran beside the native tests (log: $early_log):"
+  fi
+  trap - EXIT
+  grep -E '^(arm64: built|run: trixie (root|build) took|early builds:)' "$early_log" | sed 's/^/run:   /' || true
+fi
 
 if [ "$arm64" = 1 ]; then
   "$root/tests/arm64/run.sh" || rc=$?

@@ -7,10 +7,17 @@
 # left out; without, everything is installed and built (the tests, the benchmarks).
 #        tests/setup.sh --print-packages CODENAME   prints the build packages of that Debian release, one a line
 #                                                   (the trixie stage installs them in its Debian 13 root)
+#        tests/setup.sh --install-only              installs every Debian and npm package, builds nothing
+#                                                   (tests/run.sh, to start the later stages' downloads first)
 # Debian bookworm (12) and trixie (13) are both supported; the release is read from /etc/os-release.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 print_only=""
+install_only=""
+if [ "${1:-}" = --install-only ]; then
+  install_only=1
+  shift
+fi
 if [ "${1:-}" = --print-packages ]; then
   print_only=1
   codename="${2:?usage: tests/setup.sh --print-packages CODENAME}"
@@ -140,6 +147,8 @@ if [ ! -d "$root/tests/browser/node_modules/puppeteer-core" ]; then
   echo "setup: installing puppeteer-core (npm)"
   (cd "$root/tests/browser" && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error)
 fi
+
+[ -z "$install_only" ] || exit 0
 
 echo "setup: building ($preset)"
 cmake --preset "$preset" -S "$root" >/dev/null
