@@ -92,7 +92,9 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
                           {"skin_bgr", bgr(h.skinColour)},
                           {"beard", h.beard},
                           {"moustache", h.moustache},
-                          {"evidence", {{"crown", e.crown}, {"hair_from_skin", e.hairFromSkin}, {"beside_face", e.besideFace},
+                          {"evidence", {{"crown", e.crown}, {"hair_from_skin", e.hairFromSkin}, {"forehead_from_skin", e.foreheadFromSkin},
+                                        {"crown_hue_shift_deg", e.crownHueShift}, {"crown_saturation", e.crownSaturation},
+                                        {"hairline", e.hairline}, {"beside_face", e.besideFace},
                                         {"below_chin", e.belowChin}, {"behind_head", e.behindHead},
                                         {"down_the_back", e.downTheBack}, {"chin_darkening", e.chinDarkening},
                                         {"upper_lip_darkening", e.upperLipDarkening}, {"jaw_darkening", e.jawDarkening}}}};

@@ -9,6 +9,7 @@
 
 #include "booth/session_folder.h"
 #include "fit/export/glb.h"
+#include "fit/face/hair_analysis.h"
 #include "fit/fit_pipeline.h"
 #include "fit/head/base_head.h"
 #include "render/mesh_renderer.h"
@@ -55,6 +56,8 @@ TEST(Likeness, ScanFaceRegionNearerThanTheUnfittedHeadAndNoFolds) {
         const fs::path out = work / (std::string("side") + side);
         const FitOutcome outcome = pipeline.fit(inputs);
         writeSessionFolder(outcome, {inputs}, out, renderer);
+        // The scan's head is bald: its crown's shading is no hair (fit/face/hair_analysis.h).
+        EXPECT_EQ(outcome.hair.style, HairStyle::None) << side << ": " << toString(outcome.hair.style);
         fits += " --fit " + quoted(out / "avatar.glb") + " --name fit" + side;
         // folds.py compares a head of the base head's topology: avatar.glb's head lost its eyeballs to the eye part.
         writeGlb(out / "head_topology.glb", outcome.fit.mesh, outcome.texture.texture);

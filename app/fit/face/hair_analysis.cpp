@@ -153,7 +153,22 @@ std::vector<cv::Rect> sideCrown(const cv::Mat& mask, const cv::Point2d& ear, dou
     return crown;
 }
 
-Analysis analyse(const HairPhotos& photos, HairEstimate& out) {
+// Saturation that shading keeps: C* over L* + 16 (scaling a colour's XYZ by k scales both by k^(1/3)).
+double saturation(const cv::Vec3d& lab) { return std::hypot(lab[1], lab[2]) / (std::max(0.0, lab[0]) + 16.0); }
+
+double hueDegrees(const cv::Vec3d& lab) { return std::atan2(lab[2], lab[1]) * 180.0 / 3.14159265358979323846; }
+
+// The hairline's share (HairEvidence::hairline) of one crown column: going up from `from` to `to` (rows, from > to) in
+// `lab` (blurred), the largest change within `step` rows over the change from the first row to the last.
+double hairlineShare(const cv::Mat& lab, int x, int from, int to, int step) {
+    if (from - to <= step) return 0.0;
+    const auto at = [&](int y) { return lab.at<cv::Vec3f>(y, x); };
+    double largest = 0.0;
+    for (int y = from - step; y >= to; --y) largest = std::max(largest, labDistance(at(y), cv::Vec3d(at(y + step))));
+    return largest / std::max(1.0, labDistance(at(to), cv::Vec3d(at(from))));
+}
+
+Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions& options) {
     checkPhoto(photos.front, photos.frontMask, "front photo");
     checkPhoto(photos.side, photos.sideMask, "side photo");
     for (const char* name : {"nasion", "chin", "ear_hole"})
@@ -226,6 +241,37 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out) {
         out.hairLab = a.hairLab;
         out.evidence.hairFromSkin = labDistance(cv::Vec3f(a.hairLab), a.skinLab);
         out.colour = {median(hairBgr[0]), median(hairBgr[1]), median(hairBgr[2])};
+
+        // --- Hair, or the forehead's skin in the shade (HairOptions::shadeHueShift says why).
+        const auto inBox = [&](int x, int y) { return inFront(x, y); };
+        const auto [forehead, foreheadPixels] =
+            channelMedians<float>(a.frontLab, rectOf(midX - 15.0 * mm, browY - 20.0 * mm, midX + 15.0 * mm, browY - 5.0 * mm), inBox);
+        HairEvidence& e = out.evidence;
+        e.foreheadFromSkin = labDistance(cv::Vec3f(forehead), a.skinLab);
+        e.crownHueShift = std::abs(std::remainder(hueDegrees(a.hairLab) - hueDegrees(forehead), 360.0));
+        e.crownSaturation = saturation(a.hairLab) / std::max(1e-3, saturation(forehead));
+        // Each crown column from 10 mm over the brows (above the brows' hair) to 3 mm under the silhouette's top
+        // (whose pixels mix with the backdrop), blurred by 1 mm (single hairs, the camera's noise).
+        const int from = static_cast<int>(browY - 10.0 * mm);
+        cv::Rect span(0, 0, 0, 0);
+        for (const cv::Rect& r : a.crown) span |= cv::Rect(r.x, r.y, 1, std::max(1, from - r.y + 1));
+        span &= cv::Rect(0, 0, fm.cols, fm.rows);
+        std::vector<double> shares;
+        if (span.area() > 0 && foreheadPixels > 0) {
+            cv::Mat blurred;
+            cv::GaussianBlur(a.frontLab(span), blurred, cv::Size(0, 0), 1.0 * mm);
+            const int step = std::max(1, static_cast<int>(std::lround(4.0 * mm)));
+            for (const cv::Rect& r : a.crown) {
+                const int to = static_cast<int>(r.y + 3.0 * mm);
+                if (from >= span.y + span.height || to < span.y) continue;
+                shares.push_back(hairlineShare(blurred, r.x - span.x, from - span.y, to - span.y, step));
+            }
+        }
+        e.hairline = median(shares);
+        const bool foreheadIsSkin = foreheadPixels > 0 && e.foreheadFromSkin <= kSkinRadius;
+        if (foreheadIsSkin && e.crownHueShift <= options.shadeHueShift && e.crownSaturation > options.shadeSaturation &&
+            e.hairline <= options.hairlineStep)
+            a.hair = false;
     }
 
     // --- Front windows: beside the jaw from the nose's base to the lower lip, and beside the neck under the chin.
@@ -276,7 +322,7 @@ std::optional<HairStyle> hairStyleFromString(std::string_view name) {
 
 HairEstimate estimateHair(const HairPhotos& photos, const HairOptions& options) {
     HairEstimate out;
-    const Analysis a = analyse(photos, out);
+    const Analysis a = analyse(photos, out, options);
     HairEvidence& e = out.evidence;
     e.besideFace = 0.5 * (share(a.frontHair, a.besideFace[0]) + share(a.frontHair, a.besideFace[1]));
     e.belowChin = 0.5 * (share(a.frontHair, a.belowChin[0]) + share(a.frontHair, a.belowChin[1]));
@@ -327,7 +373,7 @@ cv::Mat hairPixels(const cv::Mat& bgr, const cv::Mat& personMask, const HairEsti
 
 std::pair<cv::Mat, cv::Mat> drawHairOverlay(const HairPhotos& photos, const HairEstimate& estimate) {
     HairEstimate scratch;
-    const Analysis a = analyse(photos, scratch);
+    const Analysis a = analyse(photos, scratch, HairOptions{});
     const auto tint = [&](cv::Mat& canvas, const cv::Mat& hair) {
         for (int y = 0; y < canvas.rows; ++y)
             for (int x = 0; x < canvas.cols; ++x)

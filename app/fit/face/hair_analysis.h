@@ -37,6 +37,17 @@ struct HairEvidence {
     // The crown's unlike-skin pixels' median against the skin's (labDistance units). Not used: a bald scalp in the
     // top light (15-30) and blond or light brown hair on pale skin (14-26) overlap on the synthetic people.
     double hairFromSkin = 0.0;
+    // Whether the crown's colour is the forehead's skin in the shade (a bald head) rather than hair: the crown's
+    // unlike-skin median against the forehead's skin (5-20 mm over the brows). Shading scales the light a surface
+    // sends back, so it keeps the skin's hue and (but for the room's grey light in the shade) its saturation
+    // C*/(L*+16); hair has a pigment of its own.
+    double foreheadFromSkin = 0.0;   // the forehead's median against the cheeks' (labDistance; over 14: a fringe)
+    double crownHueShift = 0.0;      // degrees between the crown's hue and the forehead's
+    double crownSaturation = 0.0;    // the crown's saturation over the forehead's
+    // The share of the change from the forehead to the crown that happens within 4 mm going up (the median over the
+    // crown's columns): a hairline changes the colour within a few millimetres, shading as the skull turns from the
+    // light over the 50 mm and more between brows and crown.
+    double hairline = 0.0;
     double besideFace = 0.0;       // front: beside the jaw, from the nose's base to the lower lip
     double belowChin = 0.0;        // front: beside the neck, 10-45 mm under the chin
     double behindHead = 0.0;       // side: 65-160 mm behind the ear hole, 48-70 mm under it
@@ -78,6 +89,17 @@ struct HairOptions {
     double longBeside = 0.1;
     double beside = 0.2;         // besideFace over this (not long): a bob
     double ponytail = 0.3;       // downTheBack and behindHead over this (nothing beside the face or neck): a ponytail
+    // The crown is the forehead's skin in the shade (no hair) when, with the forehead itself skin, its colour is
+    // one shading can give (hue within shadeHueShift degrees of the forehead's, saturation over shadeSaturation of
+    // it) and no hairline lies between them (HairEvidence::hairline under hairlineStep). Shading keeps the hue but
+    // for the light's own tint: the bald crowns (the scan, HairPopulation's five) 3.8-5.2 degrees off the forehead,
+    // FRMDB's brown hair 14-41 (redder than the skin). Shade mixes the room's grey light in: the bald crowns keep
+    // 0.47-1.53 of the forehead's saturation, grey, white and black hair 0.04-0.24 (a third: between the two by
+    // their ratio). Dark brown hair can have the skin's hue and saturation (HairPopulation 1, 5, 14, 16, 23): its
+    // hairline tells it (0.77-1.74 of the change within 4 mm, the bald 0.17-0.23; half: most of the change at once).
+    double shadeHueShift = 10.0;
+    double shadeSaturation = 1.0 / 3.0;
+    double hairlineStep = 0.5;
     double beardDarkening = 14.0;   // chin (and jaw at 0.5 of it) L* under the cheeks' by this much: a beard
     double moustacheDarkening = 16.0;  // the upper lip's (shaded by the nose even when bare): a moustache
 };
