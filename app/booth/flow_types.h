@@ -47,6 +47,7 @@ enum class FitFailure {
     NoFace,       // no face found in the photo
     NotProfile,   // the side photo is not a profile (a front view)
     TurnMore,     // the side photo is turned, but not far enough for a profile
+    TurnBack,     // the side photo is turned past the profile
     Mismatch,     // the two photos do not belong together
     Other,        // anything else (internal error, disk full, ...)
 };

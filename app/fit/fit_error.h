@@ -17,6 +17,7 @@ enum class FitFault {
     NoFace,      // no face or head found where one was looked for
     NotProfile,  // the side photo shows a front view
     TurnMore,    // the side photo is turned, but not far enough for a profile
+    TurnBack,    // the side photo is turned past the profile (more of the back of the head shows)
     Mismatch,    // the two photos do not show the same head the same way
     Other,       // anything else (an unreadable file, an internal failure)
 };

@@ -124,6 +124,13 @@ std::vector<Case> allScreens() {
         m.banner = BannerKind::FitFailed;
         m.fitFailure = FitFailure::NotProfile;
     });
+    add("side_guide_turned_past", [](ScreenModel& m) {
+        m.id = ScreenId::SideGuide;
+        m.photo = Photo::Side;
+        m.hint = Hint::TurnBack;
+        m.banner = BannerKind::FitFailed;
+        m.fitFailure = FitFailure::TurnBack;
+    });
     add("side_countdown", [](ScreenModel& m) {
         m.id = ScreenId::Countdown;
         m.photo = Photo::Side;

@@ -8,6 +8,7 @@
 
 namespace {
 
+using avatarbooth::degreesPastProfile;
 using avatarbooth::EarPlace;
 using avatarbooth::readEarColumns;
 using avatarbooth::turnedPastProfile;
@@ -73,4 +74,18 @@ TEST(TurnedPastProfile, NeedsTheEarCloseAndTheEyeAgreeing) {
     none = ear;
     none.headLength = 0.0;
     EXPECT_FALSE(turnedPastProfile(20.0, none));
+}
+
+TEST(ProfileTurn, DegreesPastTheProfileFromTheEarsShare) {
+    EarPlace ear;
+    ear.found = true;
+    ear.headLength = 1.4;
+    ear.front = 0.525 * 1.4;  // where the ear lies in a profile
+    EXPECT_NEAR(degreesPastProfile(ear), 0.0, 1e-12);
+    ear.front = 0.27 * 1.4;  // 0.255 of the head nearer the face: 0.0085 a degree
+    EXPECT_NEAR(degreesPastProfile(ear), 30.0, 1e-9);
+    ear.front = 0.60 * 1.4;  // turned short of the profile: nothing past it
+    EXPECT_DOUBLE_EQ(degreesPastProfile(ear), 0.0);
+    ear.found = false;
+    EXPECT_DOUBLE_EQ(degreesPastProfile(ear), 0.0);
 }

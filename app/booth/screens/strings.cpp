@@ -60,6 +60,7 @@ constexpr std::string_view kRequired[] = {
     "error.fit.no_face",
     "error.fit.not_profile",
     "error.fit.turn_more",
+    "error.fit.turn_back",
     "error.fit.mismatch",
     "error.fit.other",
     "error.save_failed",

@@ -666,6 +666,11 @@ EarPlace readEarColumns(const std::vector<double>& columns, double noseAhead, do
     return ear;
 }
 
+double degreesPastProfile(const EarPlace& ear) {
+    if (!ear.found || ear.headLength <= 0.0) return 0.0;
+    return std::max(0.0, (kEarShareAtProfile - ear.front / ear.headLength) / kEarSharePerDegree);
+}
+
 bool turnedPastProfile(double eyeDegrees, const EarPlace& ear) {
     return ear.found && ear.headLength > 0.0 && ear.front / ear.headLength <= kEarShareTurnBack &&
            ear.fold <= kEarFoldTurnBack && eyeDegrees >= kEyeTurnBackDegrees;
@@ -794,6 +799,15 @@ SideAnalysis analyseSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate
         out.warnings.push_back("the head runs out of the photo at the side: face or back of head may be cut");
     out.warnings.insert(out.warnings.end(), fit.warnings.begin(), fit.warnings.end());
     out.turn = estimateProfileTurn(bgr, out.mask, out.landmarks, out.noseImageRight);
+    if (options.refusePastProfile && out.turn.pastProfile) {
+        const double past = degreesPastProfile(out.turn.ear);
+        throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::TurnBack, "",
+                       cv::format("the side photo is turned past the profile, about %.0f degrees from the front (the "
+                                  "ear's front is %.2f of the head's length behind the nose tip, about %.2f in a "
+                                  "profile): turn about %.0f degrees back",
+                                  90.0 + past, out.turn.ear.front / out.turn.ear.headLength, kEarShareAtProfile,
+                                  past));
+    }
     return out;
 }
 

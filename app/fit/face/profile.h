@@ -106,6 +106,11 @@ bool turnedPastProfile(double eyeDegrees, const EarPlace& ear);
 inline constexpr double kEarShareTurnBack = 0.318;
 inline constexpr double kEarFoldTurnBack = 0.60;  // V behind the nose tip
 inline constexpr double kEyeTurnBackDegrees = 8.0;
+// How far past the profile an ear's share says a head is turned, for the words told to the visitor: the share is
+// 0.49-0.56 at a profile on the synthetic visitors and falls 0.08-0.09 per 10 degrees (README, issue 22).
+inline constexpr double kEarShareAtProfile = 0.525;
+inline constexpr double kEarSharePerDegree = 0.0085;
+double degreesPastProfile(const EarPlace& ear);
 
 struct SideAnalysis {
     cv::Mat mask;                        // CV_8U, 255 on the person (see segmentPerson)
@@ -145,6 +150,9 @@ struct SideOptions {
     // With it, a frontal face found on the head gets dlib's 68 points: turned more than kHalfTurnedYaw it is a
     // visitor half-way round (told to turn more), else a front view. Null: every frontal face is a front view.
     const LandmarkDetector* landmarkDetector = nullptr;
+    // Refuse a side photo turned past the profile (ProfileTurn::pastProfile, the cue on which the kiosk's side
+    // guide says "turn a little back"): the same photo taken 20 degrees nearer the profile fits better.
+    bool refusePastProfile = true;
 };
 
 // A face's turn from the front by its 68 points: the nose tip's offset from the middle of the eyes' outer corners,
