@@ -4,10 +4,10 @@
 # (tests/arm64/setup.sh) and the Debian 13 root (tests/trixie/setup.sh). Started by tests/run.sh in the
 # background once the packages are installed; it waits for this before the tests start, so that nothing downloads
 # beside a test that times the booth.
-# These phases are mostly network and disk: on CI's fresh 2-core machine they cost 5-6 minutes one after another
-# (README, "Building for the board"); beside the build they cost it far less. Each set-up keeps what it made under a
-# key and its stage runs it again: a failure here only prints, and the stage makes the same attempt and fails
-# with the full message if it fails again.
+# They wait on the mirror, and unpack and configure packages: what they wait no longer adds to the run, what they
+# compute slows the build beside them (README, "Building for the board", has both figures). Each set-up keeps what
+# it made under a key and its stage runs it again: a failure here only prints, and the stage makes the same
+# attempt and fails with the full message if it fails again.
 # Usage: tests/prepare_stages.sh KERNEL_CACHE_DIR ARM64(0|1) TRIXIE(0|1) LOG_DIR
 set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -30,7 +30,7 @@ prepare() {
   fi
 }
 
-# The three at once: each waits mostly on the mirror, and together they end well inside the build.
+# The three at once: together they end inside the build.
 prepare kernel-guest "$root/tests/kernel/setup.sh" "$kernel_cache" &
 [ "$arm64" = 1 ] && prepare arm64-sysroot "$root/tests/arm64/setup.sh" &
 [ "$trixie" = 1 ] && prepare trixie-root "$root/tests/trixie/setup.sh" &

@@ -8,9 +8,8 @@
 # Then the trixie stage: the build and the tests in a Debian 13 root, the kernel tests of the gpiod 2 and
 # libcamera 0.4 builds in the guest, the .deb installed there (tests/trixie/run.sh). AVATARBOOTH_TRIXIE=0/1 likewise.
 # CI's budget is 45 minutes for all of it on a fresh 2-core machine; the README ("Building for the board") has the
-# measured figures of each phase. Each phase prints its time ("run: ... took N s"). To fit the budget the later
-# stages' downloads run beside the native build (tests/prepare_stages.sh), and their builds beside the native tests
-# at idle priority (below).
+# measured figures of each phase. Each phase prints its time ("run: ... took N s"). The later stages' downloads run
+# beside the native build (tests/prepare_stages.sh).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 preset="${1:-release}"
@@ -41,38 +40,9 @@ echo "run: set-up and native build took $((build_done - start)) s, then $((setup
 export EGL_PLATFORM=surfaceless
 # No `exit` on failure before the arm64 and trixie stages: CI reports all, and fails if any failed.
 rc=0
-# The later stages' builds start beside the native tests at SCHED_IDLE (chrt --idle): a compiler then runs only on
-# a core no test wants (a test that wakes takes the core back at once), and many tests wait on the kiosk's clock, a
-# browser or the guest. What is not built when the tests end is killed (make deletes what it was writing) and the
-# stage builds it at normal priority.
-early_log="$root/build/$preset/early-builds.log"
-early_pid=""
-if [ "$arm64" = 1 ] || [ "$trixie" = 1 ]; then
-  set -m
-  chrt --idle 0 bash -c '
-    if [ "$1" = 1 ]; then "$3/tests/arm64/run.sh" --build-only || echo "early builds: arm64 failed (exit $?)"; fi
-    if [ "$2" = 1 ]; then "$3/tests/trixie/run.sh" --build-only || echo "early builds: trixie failed (exit $?)"; fi
-    echo "early builds: finished"
-  ' early_builds "$arm64" "$trixie" "$root" >"$early_log" 2>&1 &
-  early_pid=$!
-  set +m
-  trap 'kill -- -$early_pid 2>/dev/null || true' EXIT
-fi
 ctest --preset "$preset" --timeout 900 --parallel "$(nproc)" "$@" || rc=$?
 tests_done=$SECONDS
 echo "run: native tests took $((tests_done - setup_done)) s"
-if [ -n "$early_pid" ]; then
-  if kill -0 "$early_pid" 2>/dev/null; then
-    kill -TERM -- "-$early_pid" 2>/dev/null || true
-    wait "$early_pid" 2>/dev/null || true
-    echo "run: the later stages' builds ran beside the native tests, unfinished (log: $early_log):"
-  else
-    wait "$early_pid" 2>/dev/null || true
-    echo "run: the later stages' builds ran beside the native tests (log: $early_log):"
-  fi
-  trap - EXIT
-  grep -E '^(arm64: built|run: trixie (root|build) took|early builds:)' "$early_log" | sed 's/^/run:   /' || true
-fi
 
 if [ "$arm64" = 1 ]; then
   "$root/tests/arm64/run.sh" || rc=$?

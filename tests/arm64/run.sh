@@ -5,13 +5,9 @@
 # kernel guest and never run here; the native stage compiles them with the same warnings, so the cross build leaves
 # them out (it halves the stage on a 2-core machine).
 # Usage: tests/arm64/run.sh [extra ctest arguments]   (tests/run.sh ci runs it after the native tests)
-#        tests/arm64/run.sh --build-only   the sysroot and the cross build, no tests (tests/run.sh runs it beside the
-#                                          native tests, at idle priority)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 cd "$root"
-build_only=""
-if [ "${1:-}" = --build-only ]; then build_only=1; shift; fi
 start=$SECONDS
 "$root/tests/arm64/setup.sh"
 sysroot_done=$SECONDS
@@ -19,7 +15,6 @@ echo "arm64: cross-building (preset arm64, build/arm64)"
 cmake --preset arm64 >/dev/null
 cmake --build --preset arm64 -j "$(nproc)" --target avatarbooth unit_tests
 build_done=$SECONDS
-if [ -n "$build_only" ]; then echo "arm64: built in $((build_done - sysroot_done)) s"; exit 0; fi
 readelf -h build/arm64/app/avatarbooth | grep -q 'Machine:.*AArch64' ||
   { echo "arm64: build/arm64/app/avatarbooth is not an arm64 executable" >&2; exit 1; }
 echo "arm64: unit tests under qemu-aarch64"

@@ -13,13 +13,9 @@
 # Each phase prints its time. The root is a plain chroot with /proc, /sys, /dev and the checkout bound in, in a
 # mount namespace of its own (nothing stays mounted after a phase, even when it fails).
 # Usage: tests/trixie/run.sh [extra ctest arguments]   (tests/run.sh ci runs it after the arm64 stage; as root)
-#        tests/trixie/run.sh --build-only   phases 1 and 2 only (tests/run.sh runs it beside the native tests, at
-#                                           idle priority)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 cd "$root"
-build_only=""
-if [ "${1:-}" = --build-only ]; then build_only=1; shift; fi
 rootfs="${TRIXIE_ROOT:-$root/build/trixie-root}"
 build="$root/build/trixie"
 jobs="$(nproc)"
@@ -73,7 +69,6 @@ in_root "echo \"trixie: \$(gcc --version | head -1), \$(cmake --version | head -
   cmake --preset trixie >/dev/null && cmake --build --preset trixie -j $jobs --target $targets"
 cpu; build_done=$SECONDS build_cpu=$CPU
 echo "run: trixie build took $((build_done - root_done)) s (CPU $((build_cpu - root_cpu)) s)"
-[ -z "$build_only" ] || exit 0
 
 # No exit on a failed phase: the later ones still run, and the stage fails if any did.
 rc=0
