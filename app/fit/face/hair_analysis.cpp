@@ -333,7 +333,8 @@ HairEstimate estimateHair(const HairPhotos& photos, const HairOptions& options) 
     // nothing beside the face, hanging from the back of the head down (a dark shirt under short hair fills the lower
     // window alone); a bob beside the face down to the jaw. The side's windows sit where hoods and collars
     // often are, so the front decides where it can.
-    if (!a.hair || e.crown < options.bald) out.style = HairStyle::None;
+    // Few crown pixels unlike skin is no hair, unless a hairline shows: hair of the skin's own colour.
+    if (!a.hair || (e.crown < options.bald && e.hairline <= options.hairlineStep)) out.style = HairStyle::None;
     else if (e.belowChin > options.long_ && e.besideFace > options.longBeside) out.style = HairStyle::Long;
     else if (e.besideFace > options.beside) out.style = HairStyle::Bob;
     else if (e.downTheBack > options.ponytail && e.behindHead > options.ponytail) out.style = HairStyle::Ponytail;
