@@ -243,9 +243,8 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions&
         out.colour = {median(hairBgr[0]), median(hairBgr[1]), median(hairBgr[2])};
 
         // --- Hair, or the forehead's skin in the shade (HairOptions::shadeHueShift says why).
-        const auto inBox = [&](int x, int y) { return inFront(x, y); };
         const auto [forehead, foreheadPixels] =
-            channelMedians<float>(a.frontLab, rectOf(midX - 15.0 * mm, browY - 20.0 * mm, midX + 15.0 * mm, browY - 5.0 * mm), inBox);
+            channelMedians<float>(a.frontLab, rectOf(midX - 15.0 * mm, browY - 20.0 * mm, midX + 15.0 * mm, browY - 5.0 * mm), inFront);
         HairEvidence& e = out.evidence;
         e.foreheadFromSkin = labDistance(cv::Vec3f(forehead), a.skinLab);
         e.crownHueShift = std::abs(std::remainder(hueDegrees(a.hairLab) - hueDegrees(forehead), 360.0));
