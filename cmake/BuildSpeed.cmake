@@ -30,15 +30,17 @@ function(avatarbooth_test_code_opt target)
   endif()
 endfunction()
 
-# Unity builds of the booth's libraries and executable (CMake's UNITY_BUILD, batches of 8 sources): each batch
-# parses the shared headers and instantiates the shared templates (OpenCV, dlib, JSON, spdlog, GLM) once instead
-# of once per file. On by the ci presets (ci, arm64, trixie: three builds from scratch in every CI run); off for
-# developers, whose incremental builds would recompile a whole batch for one file. The sources of a batch share
-# one translation unit, so two helpers of the same name in anonymous namespaces of one library clash: a source
-# that must keep such a helper sets SKIP_UNITY_BUILD_INCLUSION (sim/CMakeLists.txt). GCC's -Wsubobject-linkage
-# is meant for headers and fires on a source's own anonymous types once it is included into a batch: it is off
-# in a unity build. The README ("Building for the board") has the figures.
-option(AVATARBOOTH_UNITY "Unity builds of the booth's own libraries (not the tests)" OFF)
+# Unity builds of the booth's libraries, its executable and the test executables (CMake's UNITY_BUILD, batches of 8
+# sources): each batch parses the shared headers and instantiates the shared templates (OpenCV, dlib, JSON, spdlog,
+# GLM, GoogleTest) once instead of once per file. On by the ci presets (ci, arm64, trixie: three builds from scratch
+# in every CI run); off for developers, whose incremental builds would recompile a whole batch for one file. The
+# sources of a batch share one translation unit, so two helpers of the same name in anonymous namespaces of one
+# target clash, and a file-scope `using namespace` reaches the files after it: give a test's helper a name of its
+# own, or share it through a header (tests/test_paths.h); a source that must keep such a helper sets
+# SKIP_UNITY_BUILD_INCLUSION (sim/CMakeLists.txt, Xlib's macros in tests/CMakeLists.txt). GCC's
+# -Wsubobject-linkage is meant for headers and fires on a source's own anonymous types once it is included into a
+# batch: it is off in a unity build. The README ("Building for the board") has the figures.
+option(AVATARBOOTH_UNITY "Unity builds of the booth's own libraries and of the tests" OFF)
 set(CMAKE_UNITY_BUILD_BATCH_SIZE 8)
 if(AVATARBOOTH_UNITY AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
   add_compile_options(-Wno-subobject-linkage)

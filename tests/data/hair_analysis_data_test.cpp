@@ -32,7 +32,7 @@ constexpr Judged kJudged[] = {
     {5, HairStyle::Long, 0},  {6, HairStyle::Long, 0},     {7, HairStyle::Long, 0},   {8, HairStyle::Bob, -1},
 };
 
-const FitPipeline& pipeline() {
+const FitPipeline& hairPipeline() {
     static const FitPipeline p{FitSettings{}};
     return p;
 }
@@ -49,7 +49,7 @@ Result analysePair(int person, const char* sideFile) {
     HairPhotos photos;
     photos.front = readPhoto(dir / "Img_33.jpg");
     photos.side = readPhoto(dir / sideFile);
-    const FrontAnalysis front = pipeline().analyseFront(photos.front, cv::Mat());
+    const FrontAnalysis front = hairPipeline().analyseFront(photos.front, cv::Mat());
     photos.frontMask = front.mask;
     photos.frontPoints = front.landmarks.points;
     const SideAnalysis side = analyseSidePhoto(photos.side);

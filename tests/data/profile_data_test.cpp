@@ -29,10 +29,6 @@ namespace fs = std::filesystem;
 
 fs::path scanDir() { return avatarbooth::test::sharedData() / "scan_lee_perry_smith"; }
 
-double millisecondsSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // The anatomical order along the face, top to bottom (glabella and nasion may share a height).
 void expectAnatomicalOrder(const SideAnalysis& a) {
     const char* order[] = {"top_of_head", "forehead", "glabella", "nasion", "nose_tip", "subnasale",
@@ -79,7 +75,7 @@ TEST(ProfileData, FrmdbProfilesBothDirections) {
                 ADD_FAILURE() << "refused: " << e.what();
                 continue;
             }
-            total += millisecondsSince(t0);
+            total += avatarbooth::test::millisecondsSince(t0);
             ++count;
             cv::Mat overlay = bgr.clone();
             avatarbooth::drawSideOverlay(overlay, a);
@@ -283,7 +279,7 @@ void checkScanProfile(const std::string& view, bool noseRight) {
     ASSERT_FALSE(bgr.empty());
     const auto t0 = std::chrono::steady_clock::now();
     const SideAnalysis a = analyseSidePhoto(bgr);
-    const double ms = millisecondsSince(t0);
+    const double ms = avatarbooth::test::millisecondsSince(t0);
     EXPECT_EQ(a.noseImageRight, noseRight);
     cv::Mat overlay = bgr.clone();
     avatarbooth::drawSideOverlay(overlay, a);

@@ -54,11 +54,6 @@ std::vector<fs::path> frontalPhotos() {
     return photos;
 }
 
-std::string readAll(const fs::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 void writeAll(const fs::path& file, const std::string& bytes) { std::ofstream(file, std::ios::binary) << bytes; }
 
 ino_t inodeOf(const fs::path& file) {
@@ -240,12 +235,12 @@ TEST(QuantizedShapePredictor, CachesGiveExactlyTheConvertedLandmarksOnRealFaces)
     EXPECT_GE(photos, 15);
 
     // A damaged detector cache is made again, to the same bytes, and the detector finds the same faces.
-    const std::string good = readAll(detectorCache);
+    const std::string good = avatarbooth::test::readFileBytes(detectorCache);
     std::string damaged = good;
     damaged[damaged.size() / 2] = static_cast<char>(damaged[damaged.size() / 2] ^ 0x04);
     writeAll(detectorCache, damaged);
     const LandmarkDetector rebuilt(modelFile, cache);
-    EXPECT_EQ(readAll(detectorCache), good);
+    EXPECT_EQ(avatarbooth::test::readFileBytes(detectorCache), good);
     const cv::Mat photo = readPhoto(test::sharedData() / "frmdb" / "001" / "Img_33.jpg");
     EXPECT_EQ(rebuilt.detectFaces(photo), fresh.detectFaces(photo));
 }
@@ -262,7 +257,7 @@ TEST(QuantizedShapePredictor, DamagedStaleOrForeignCachesAreRebuilt) {
     EXPECT_EQ(modeOf(cacheDir), fs::perms::owner_all);
     EXPECT_EQ(modeOf(cache), fs::perms::owner_read | fs::perms::owner_write);
     ASSERT_EQ(load()->cacheRead(), cache);
-    const std::string good = readAll(cache);
+    const std::string good = avatarbooth::test::readFileBytes(cache);
 
     const auto expectRebuilt = [&](const std::string& how) {
         const auto predictor = load();
@@ -275,10 +270,10 @@ TEST(QuantizedShapePredictor, DamagedStaleOrForeignCachesAreRebuilt) {
     flipped[good.size() - 100] = static_cast<char>(flipped[good.size() - 100] ^ 0x10);  // among the leaves
     writeAll(cache, flipped);
     expectRebuilt("one bit flipped");
-    EXPECT_EQ(readAll(cache), good) << "the rebuilt cache differs from the first";
+    EXPECT_EQ(avatarbooth::test::readFileBytes(cache), good) << "the rebuilt cache differs from the first";
     writeAll(cache, good.substr(0, good.size() / 2));
     expectRebuilt("truncated");
-    EXPECT_EQ(readAll(cache), good);
+    EXPECT_EQ(avatarbooth::test::readFileBytes(cache), good);
     writeAll(cache, good.substr(0, 40));
     expectRebuilt("cut inside its header");
     writeAll(cache, "");
@@ -287,7 +282,7 @@ TEST(QuantizedShapePredictor, DamagedStaleOrForeignCachesAreRebuilt) {
     expectRebuilt("not a cache file");
     fs::permissions(cache, fs::perms::others_write, fs::perm_options::add);
     expectRebuilt("writable by others");
-    EXPECT_EQ(readAll(cache), good);
+    EXPECT_EQ(avatarbooth::test::readFileBytes(cache), good);
     fs::rename(cache, dir / "elsewhere.quantized");
     fs::create_symlink(dir / "elsewhere.quantized", cache);
     expectRebuilt("a symbolic link");
@@ -296,7 +291,7 @@ TEST(QuantizedShapePredictor, DamagedStaleOrForeignCachesAreRebuilt) {
     // The model file changed (a package upgrade installs a file of another time): the cache is stale.
     fs::last_write_time(model, fs::last_write_time(model) + std::chrono::seconds(1));
     expectRebuilt("stale");
-    EXPECT_NE(readAll(cache), good) << "the stamp of the old model file was kept";
+    EXPECT_NE(avatarbooth::test::readFileBytes(cache), good) << "the stamp of the old model file was kept";
 }
 
 TEST(QuantizedShapePredictor, WithoutAWritableCacheTheConvertedModelIsUsed) {

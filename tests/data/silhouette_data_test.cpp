@@ -34,10 +34,6 @@ cv::Mat readMask(const fs::path& p) {
     return m > 127;
 }
 
-double millisecondsSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // One 8-connected component and no holes.
 void expectOneSolidComponent(const cv::Mat& mask, const std::string& what) {
     cv::Mat labels;
@@ -71,12 +67,12 @@ TEST(SilhouetteData, ScanRendersMatchTheirMasks) {
 
         auto t0 = std::chrono::steady_clock::now();
         const cv::Mat noPlate = segmentPerson(rgb);
-        const double msNoPlate = millisecondsSince(t0);
+        const double msNoPlate = avatarbooth::test::millisecondsSince(t0);
         // The renders' background is one flat colour: the plate is that colour everywhere.
         const cv::Mat plate(rgb.size(), CV_8UC3, cv::Scalar(rgb.at<cv::Vec3b>(0, 0)));
         t0 = std::chrono::steady_clock::now();
         const cv::Mat withPlate = segmentPerson(rgb, plate);
-        const double msPlate = millisecondsSince(t0);
+        const double msPlate = avatarbooth::test::millisecondsSince(t0);
 
         const double iouNoPlate = maskIoU(noPlate, truth), iouPlate = maskIoU(withPlate, truth);
         std::cout << "[ scan " << view << " ] IoU without plate " << iouNoPlate << " (" << msNoPlate
@@ -129,7 +125,7 @@ TEST(SilhouetteData, FrmdbPeopleAreOneSolidRegion) {
             ASSERT_FALSE(bgr.empty());
             const auto t0 = std::chrono::steady_clock::now();
             const cv::Mat mask = segmentPerson(bgr);
-            total += millisecondsSince(t0);
+            total += avatarbooth::test::millisecondsSince(t0);
             ++count;
             writeOverlay(dir / (id + "_" + shot + ".png"), bgr, mask);
             expectOneSolidComponent(mask, id + "/" + shot);

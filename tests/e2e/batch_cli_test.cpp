@@ -22,12 +22,7 @@ using namespace avatarbooth::test;
 
 namespace {
 
-std::string readBytes(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-nlohmann::json readJson(const fs::path& p) { return nlohmann::json::parse(readBytes(p)); }
+nlohmann::json readJson(const fs::path& p) { return nlohmann::json::parse(readFileBytes(p)); }
 
 fs::path frmdb(const std::string& person, const std::string& file) { return sharedData() / "frmdb" / person / file; }
 
@@ -51,7 +46,7 @@ TEST(BatchCli, ManifestWithBadRowsThenRerunThenReportInChromium) {
     AVATARBOOTH_REQUIRE_SHARED_DATA();
     const fs::path dir = scratchDir("e2e_batch_manifest");
     // A photo cut short in its middle (a copy is made here, in the test's scratch folder, not in the repository).
-    const std::string jpeg = readBytes(frmdb("004", "Img_33.jpg"));
+    const std::string jpeg = readFileBytes(frmdb("004", "Img_33.jpg"));
     std::ofstream(dir / "truncated.jpg", std::ios::binary) << jpeg.substr(0, jpeg.size() / 3);
     std::ofstream(dir / "manifest.csv")
         << "session,front,side\n"
@@ -107,7 +102,7 @@ TEST(BatchCli, ManifestWithBadRowsThenRerunThenReportInChromium) {
         EXPECT_LE(std::max(thumb.cols, thumb.rows), 320);
     }
     expectNoPartialFolders(out / "sessions");
-    const std::string html = readBytes(out / "report.html");
+    const std::string html = readFileBytes(out / "report.html");
     EXPECT_EQ(countOf(html, "<model-viewer "), 3);
     EXPECT_NE(html.find("model-viewer/model-viewer-umd.min.js"), std::string::npos);
     EXPECT_TRUE(fs::is_regular_file(out / "model-viewer" / "model-viewer-umd.min.js"));
@@ -231,14 +226,14 @@ TEST(BatchCli, CtrlCKeepsFinishedSessionsOnly) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(180);
     while (!fs::exists(out / "sessions" / "001" / "fit.json") && std::chrono::steady_clock::now() < deadline)
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    ASSERT_TRUE(fs::exists(out / "sessions" / "001" / "fit.json")) << readBytes(log);
+    ASSERT_TRUE(fs::exists(out / "sessions" / "001" / "fit.json")) << readFileBytes(log);
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     kill(pid, SIGINT);
     int status = 0;
     waitpid(pid, &status, 0);
-    ASSERT_TRUE(WIFEXITED(status)) << readBytes(log);
-    EXPECT_EQ(WEXITSTATUS(status), 130) << readBytes(log);
-    EXPECT_NE(readBytes(log).find("interrupted"), std::string::npos) << readBytes(log);
+    ASSERT_TRUE(WIFEXITED(status)) << readFileBytes(log);
+    EXPECT_EQ(WEXITSTATUS(status), 130) << readFileBytes(log);
+    EXPECT_NE(readFileBytes(log).find("interrupted"), std::string::npos) << readFileBytes(log);
     expectNoPartialFolders(out / "sessions");
     const nlohmann::json s = readJson(out / "summary.json");
     EXPECT_TRUE(s["run"]["interrupted"].get<bool>());

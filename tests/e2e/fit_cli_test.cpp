@@ -40,11 +40,6 @@ void writeBytes(const fs::path& p, const std::string& bytes) {
     std::ofstream(p, std::ios::binary) << bytes;
 }
 
-std::string readBytes(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 // Nothing of a failed run may remain next to the output folder (no partial staging folders either).
 void expectNoLeftovers(const fs::path& parent) {
     for (const auto& e : fs::directory_iterator(parent))
@@ -74,7 +69,7 @@ TEST(FitCli, WritesACompleteSessionFolderWithAValidGlb) {
     EXPECT_EQ(pclose(pipe), 0) << report;
     EXPECT_NE(report.find("\"errors\":0"), std::string::npos) << report;
     // With the product's base head the avatar is made of parts, one node each: the brows blended, the lashes masked.
-    const std::string glb = readBytes(out / "avatar.glb");
+    const std::string glb = readFileBytes(out / "avatar.glb");
     ASSERT_GT(glb.size(), 20u);
     std::uint32_t jsonLength = 0;
     std::memcpy(&jsonLength, glb.data() + 12, 4);
@@ -83,7 +78,7 @@ TEST(FitCli, WritesACompleteSessionFolderWithAValidGlb) {
                              "\"alphaMode\":\"BLEND\"", "\"alphaMode\":\"MASK\""})
         EXPECT_NE(json.find(node), std::string::npos) << node;
     // fit.json says which hair the analysis chose and by what; the avatar wears that hair (a "hair" part) or none.
-    const nlohmann::json fitJson = nlohmann::json::parse(readBytes(out / "fit.json"));
+    const nlohmann::json fitJson = nlohmann::json::parse(readFileBytes(out / "fit.json"));
     ASSERT_TRUE(fitJson.contains("hair")) << fitJson.dump(1);
     const std::string style = fitJson["hair"]["style"].get<std::string>();
     EXPECT_TRUE(style == "none" || style == "short" || style == "bob" || style == "long" || style == "ponytail") << style;
@@ -105,11 +100,11 @@ TEST(FitCli, RerunReplacesAnEarlierResultAndAFailedRunKeepsIt) {
     const fs::path dir = scratchDir("e2e_rerun");
     const fs::path out = dir / "session";
     ASSERT_EQ(runAvatarbooth(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", out)).exitCode, 0);
-    const std::string before = readBytes(out / "fit.json");
+    const std::string before = readFileBytes(out / "fit.json");
     writeBytes(dir / "empty.jpg", "");
     const CommandResult r = runAvatarbooth(fitArgs(dir / "empty.jpg", visitor() / "side.jpg", out));
     EXPECT_EQ(r.exitCode, 3) << r.output;
-    EXPECT_EQ(readBytes(out / "fit.json"), before) << "a failed run must leave the earlier result as it was";
+    EXPECT_EQ(readFileBytes(out / "fit.json"), before) << "a failed run must leave the earlier result as it was";
     expectNoLeftovers(dir);
 }
 
@@ -119,7 +114,7 @@ TEST(FitCli, RefusesToReplaceAFolderThatIsNotAnEarlierResult) {
     writeBytes(dir / "holiday" / "photo.jpg", "keep me");
     const CommandResult r = runAvatarbooth(fitArgs(visitor() / "front.jpg", visitor() / "side.jpg", dir / "holiday"));
     EXPECT_EQ(r.exitCode, 7) << r.output;
-    EXPECT_EQ(readBytes(dir / "holiday" / "photo.jpg"), "keep me");
+    EXPECT_EQ(readFileBytes(dir / "holiday" / "photo.jpg"), "keep me");
 }
 
 struct BadInputCase {
@@ -133,7 +128,7 @@ class FitCliBadInput : public ::testing::TestWithParam<BadInputCase> {};
 TEST_P(FitCliBadInput, ClearErrorOwnExitCodeNothingWritten) {
     const BadInputCase c = GetParam();
     const fs::path dir = scratchDir(std::string("e2e_bad_") + c.name);
-    const std::string frontBytes = readBytes(visitor() / "front.jpg");
+    const std::string frontBytes = readFileBytes(visitor() / "front.jpg");
     fs::path front = visitor() / "front.jpg", side = visitor() / "side.jpg";
     const std::string which = c.name;
     if (which == "truncated_jpeg") {

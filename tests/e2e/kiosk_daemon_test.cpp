@@ -31,13 +31,6 @@ using namespace avatarbooth::test;
 
 namespace {
 
-std::string readText(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
 // Polls (draining the notify socket as it goes) until `done` or the time is up or the child has exited.
 template <typename F>
 bool waitFor(F done, std::chrono::steady_clock::duration limit, NotifySocket& notify, pid_t pid, int& status,
@@ -104,20 +97,20 @@ TEST(KioskDaemon, GuideSaysNoFaceKeepsPingingAndStopsPromptlyWhileTheModelIsStil
     // synthetic visitor the sim camera shows first: seconds, more on a busy machine.)
     const bool ready = waitFor([&] { return !notify.ready.empty(); }, 90s, notify, pid, status, exited);
     if (!ready) kill9();
-    ASSERT_TRUE(ready) << "no READY=1\n" << readText(log);
+    ASSERT_TRUE(ready) << "no READY=1\n" << readFileBytes(log);
     const bool guide = waitFor([&] { return fs::exists(screens / "01_front_guide.png"); }, 30s, notify, pid, status,
                                exited);
     if (!guide) kill9();
-    ASSERT_TRUE(guide) << "no front guide screenshot\n" << readText(log);
+    ASSERT_TRUE(guide) << "no front guide screenshot\n" << readFileBytes(log);
     // The first analysis's hint (the screenshot is taken again with it when it came later than the picture).
-    waitFor([&] { return readText(log).find("front_guide: hint no_face") != std::string::npos; }, 30s, notify, pid,
+    waitFor([&] { return readFileBytes(log).find("front_guide: hint no_face") != std::string::npos; }, 30s, notify, pid,
             status, exited);
 
     // In the guide: pings every 600 ms for 3 s (no gap as long as the 1.2 s the watchdog allows).
     const auto from = std::chrono::steady_clock::now();
     waitFor([] { return false; }, 3s, notify, pid, status, exited);
     const auto to = std::chrono::steady_clock::now();
-    EXPECT_FALSE(exited) << readText(log);
+    EXPECT_FALSE(exited) << readFileBytes(log);
     EXPECT_GE(notify.pingsSince(from), 4) << "3 s in the guide";
     EXPECT_LE(notify.pingsSince(from), 6) << "pings faster than half of WATCHDOG_USEC";
     EXPECT_LT(notify.longestGapSeconds(from, to), kWatchdogUsec / 1e6) << "a watchdog ping came late";
@@ -131,7 +124,7 @@ TEST(KioskDaemon, GuideSaysNoFaceKeepsPingingAndStopsPromptlyWhileTheModelIsStil
     const double stopSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - term).count();
     const bool stopped = exited;
     kill9();
-    const std::string output = readText(log);
+    const std::string output = readFileBytes(log);
     ASSERT_TRUE(stopped) << "still running 2 s after SIGTERM\n" << output;
     EXPECT_LT(stopSeconds, 2.0);
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "status " << status << "\n" << output;

@@ -142,13 +142,6 @@ void sendKey(::Display* x, Window w, KeySym sym) {
     }
 }
 
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
 double differingShare(const cv::Mat& a, const cv::Mat& b) {
     cv::Mat diff;
     cv::absdiff(a, b, diff);
@@ -202,8 +195,8 @@ TEST(KioskWindow, KeysPressButtonsAndFramesReachTheWindowUnderXvfb) {
         }
         std::this_thread::sleep_for(200ms);
     }
-    ASSERT_NE(w, 0u) << "no window titled " << kTitle << "\n" << readFile(log);
-    ASSERT_FALSE(attract.empty()) << "no frame reached the window\n" << readFile(log);
+    ASSERT_NE(w, 0u) << "no window titled " << kTitle << "\n" << readFileBytes(log);
+    ASSERT_FALSE(attract.empty()) << "no frame reached the window\n" << readFileBytes(log);
     EXPECT_EQ(attract.cols, 1280);
     EXPECT_EQ(attract.rows, 720);
 
@@ -217,19 +210,19 @@ TEST(KioskWindow, KeysPressButtonsAndFramesReachTheWindowUnderXvfb) {
     bool started = false;
     cv::Mat guide;
     for (auto until = std::chrono::steady_clock::now() + 20s; std::chrono::steady_clock::now() < until;) {
-        started = readFile(log).find("a visitor started a session") != std::string::npos;
+        started = readFileBytes(log).find("a visitor started a session") != std::string::npos;
         if (started) {
             guide = grab(x, w);
             if (differingShare(attract, guide) > 0.15) break;
         }
         std::this_thread::sleep_for(200ms);
     }
-    EXPECT_TRUE(started) << readFile(log);
+    EXPECT_TRUE(started) << readFileBytes(log);
     ASSERT_FALSE(guide.empty());
     EXPECT_GT(differingShare(attract, guide), 0.15) << "the window still shows the attract screen";
     XCloseDisplay(x);
 
-    EXPECT_EQ(kiosk.terminate(20s), 0) << readFile(log);
-    const std::string out = readFile(log);
+    EXPECT_EQ(kiosk.terminate(20s), 0) << readFileBytes(log);
+    const std::string out = readFileBytes(log);
     EXPECT_NE(out.find("window 1280x720 on " + *display), std::string::npos) << out;
 }

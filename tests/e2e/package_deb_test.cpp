@@ -1,6 +1,7 @@
 // The Debian package: built by CPack from this build, inspected with dpkg-deb (control fields, maintainer scripts,
 // the files and where they go), unpacked into a scratch root with dpkg -x, and the installed binary run from there
 // (--version, check), so the installed layout works, not only the build tree.
+#include "run_binary.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>
@@ -18,22 +19,6 @@ using namespace avatarbooth::test;
 
 namespace {
 
-struct CommandResult {
-    int exitCode = -1;
-    std::string output;
-};
-
-CommandResult shell(const std::string& cmd) {
-    CommandResult r;
-    FILE* pipe = popen(cmd.c_str(), "r");
-    if (pipe == nullptr) return r;
-    std::array<char, 4096> buf{};
-    while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
-
 // The build tree: <build>/app/avatarbooth.
 fs::path buildDir() { return binary().parent_path().parent_path(); }
 
@@ -48,7 +33,7 @@ std::string field(const std::string& control, const std::string& name) {
 TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
     const fs::path dir = scratchDir("package_deb");
     // cpack installs the build tree (nothing is compiled: the tests depend on the built binary).
-    CommandResult r = shell("cd " + dir.string() + " && cpack --config " + (buildDir() / "CPackConfig.cmake").string() +
+    CommandResult r = runShell("cd " + dir.string() + " && cpack --config " + (buildDir() / "CPackConfig.cmake").string() +
                             " -G DEB -B " + dir.string() + " 2>&1");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     fs::path deb;
@@ -58,7 +43,7 @@ TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
     EXPECT_TRUE(std::regex_match(deb.filename().string(), std::regex("avatarbooth_[0-9.]+_[a-z0-9]+\\.deb"))) << deb;
 
     // Control fields and maintainer scripts.
-    r = shell("dpkg-deb -I " + deb.string() + " 2>&1");
+    r = runShell("dpkg-deb -I " + deb.string() + " 2>&1");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     const std::string info = r.output;
     EXPECT_EQ(field(info, "Package"), "avatarbooth");
@@ -73,17 +58,17 @@ TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
     // The control members as dpkg-deb lists them (trixie's ends the line after a member without an interpreter).
     EXPECT_TRUE(std::regex_search(info, std::regex("\\spostinst\\s"))) << info;
     EXPECT_TRUE(std::regex_search(info, std::regex("\\sconffiles\\s"))) << info;
-    r = shell("dpkg-deb --ctrl-tarfile " + deb.string() + " | tar -xO ./postinst");
+    r = runShell("dpkg-deb --ctrl-tarfile " + deb.string() + " | tar -xO ./postinst");
     ASSERT_EQ(r.exitCode, 0);
     EXPECT_NE(r.output.find("systemd-sysusers avatarbooth.conf"), std::string::npos) << r.output;
     // It enables and starts nothing the operator did not ask for.
     EXPECT_FALSE(std::regex_search(r.output, std::regex("\n[ \t]*(systemctl|deb-systemd-invoke) [^\n]*\\b(start|enable)\\b")))
         << r.output;
-    r = shell("dpkg-deb --ctrl-tarfile " + deb.string() + " | tar -xO ./conffiles");
+    r = runShell("dpkg-deb --ctrl-tarfile " + deb.string() + " | tar -xO ./conffiles");
     EXPECT_EQ(r.output, "/etc/avatarbooth/booth.toml\n");
 
     // Files and where they go.
-    r = shell("dpkg-deb -c " + deb.string());
+    r = runShell("dpkg-deb -c " + deb.string());
     ASSERT_EQ(r.exitCode, 0);
     for (const char* path : {"./usr/bin/avatarbooth", "./etc/avatarbooth/booth.toml", "./usr/share/avatarbooth/strings.toml",
                              "./usr/lib/systemd/system/avatarbooth.service",
@@ -103,10 +88,10 @@ TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
 
     // Unpacked into a scratch root; the binary found there runs and finds its own strings file and config.
     const fs::path root = dir / "root";
-    r = shell("dpkg -x " + deb.string() + " " + root.string() + " 2>&1");
+    r = runShell("dpkg -x " + deb.string() + " " + root.string() + " 2>&1");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     const fs::path installed = root / "usr/bin/avatarbooth";
-    r = shell(installed.string() + " --version 2>&1");
+    r = runShell(installed.string() + " --version 2>&1");
     EXPECT_EQ(r.exitCode, 0) << r.output;
     EXPECT_TRUE(std::regex_match(r.output, std::regex("avatarbooth [0-9]+\\.[0-9]+\\.[0-9]+\n"))) << r.output;
 
@@ -118,7 +103,7 @@ TEST(PackageDeb, BuildsInspectsUnpacksAndRuns) {
     config.replace(config.find(from), from.size(), "directory = \"" + (root / "var/lib/avatarbooth/sessions").string() + "\"");
     std::ofstream(root / "etc/avatarbooth/booth.toml") << config;
     // Run from outside the source tree, so only the installed strings file can be found.
-    r = shell("cd / && env -u AVATARBOOTH_ASSET_DIR " + installed.string() + " check --json --config " +
+    r = runShell("cd / && env -u AVATARBOOTH_ASSET_DIR " + installed.string() + " check --json --config " +
               (root / "etc/avatarbooth/booth.toml").string() + " 2>/dev/null");
     const nlohmann::json report = nlohmann::json::parse(r.output);
     std::map<std::string, std::string> last;  // check -> status of its last line

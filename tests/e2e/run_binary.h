@@ -30,6 +30,18 @@ inline CommandResult runWithRedirect(const std::string& args, const std::string&
     return r;
 }
 
+// A shell command line (`sh -c`): its exit code and what reached stdout.
+inline CommandResult runShell(const std::string& command) {
+    CommandResult r;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (pipe == nullptr) return r;
+    std::array<char, 4096> buf{};
+    while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
+    const int status = pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
 // `avatarbooth ARGS`, its exit code and everything it printed.
 inline CommandResult runAvatarbooth(const std::string& args) { return runWithRedirect(args, "2>&1"); }
 

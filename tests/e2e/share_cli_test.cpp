@@ -29,13 +29,6 @@ using namespace std::chrono_literals;
 
 namespace {
 
-std::string readText(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
 }  // namespace
 
 TEST(ShareCli, OffByDefaultListensNowhere) {
@@ -78,7 +71,7 @@ ShareProcess startShare(const fs::path& dir, const std::string& extra = "") {
         _exit(127);
     }
     for (int i = 0; i < 250 && p.port == 0 && p.pid > 0; ++i) {
-        const std::string text = readText(p.log);
+        const std::string text = readFileBytes(p.log);
         const std::size_t at = text.find("listening on 127.0.0.1:");
         if (at != std::string::npos) p.port = std::atoi(text.c_str() + at + 23);
         else std::this_thread::sleep_for(20ms);
@@ -97,7 +90,7 @@ TEST(ShareCli, ListensWhereToldAnswersAndStopsOnSigterm) {
     const pid_t pid = share.pid;
     const int port = share.port;
     const fs::path& log = share.log;
-    ASSERT_GT(port, 0) << readText(log);
+    ASSERT_GT(port, 0) << readFileBytes(log);
     // Exactly one listening socket, on 127.0.0.1 (7F000001 as the kernel writes it) and the port it printed.
     char expected[32];
     std::snprintf(expected, sizeof expected, "tcp 0100007F:%04X", port);
@@ -118,8 +111,8 @@ TEST(ShareCli, ListensWhereToldAnswersAndStopsOnSigterm) {
         waitpid(pid, &status, 0);
     }
     EXPECT_TRUE(exited) << "not stopped within 3 s of SIGTERM";
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << readText(log);
-    EXPECT_NE(readText(log).find("stopped; 0 served, 1 not found"), std::string::npos) << readText(log);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << readFileBytes(log);
+    EXPECT_NE(readFileBytes(log).find("stopped; 0 served, 1 not found"), std::string::npos) << readFileBytes(log);
 }
 
 // With the operator's certificate it speaks HTTPS only: a client that trusts that certificate gets the same 404 for
@@ -134,8 +127,8 @@ TEST(ShareCli, ServesHttpsWithTheOperatorsCertificate) {
     if (std::system(make.c_str()) != 0) GTEST_SKIP() << "openssl could not make a test certificate";
     const ShareProcess share = startShare(dir, "tls_certificate = \"" + cert.string() + "\"\ntls_key = \"" +
                                                    key.string() + "\"\n");
-    ASSERT_GT(share.port, 0) << readText(share.log);
-    EXPECT_NE(readText(share.log).find("(https)"), std::string::npos) << readText(share.log);
+    ASSERT_GT(share.port, 0) << readFileBytes(share.log);
+    EXPECT_NE(readFileBytes(share.log).find("(https)"), std::string::npos) << readFileBytes(share.log);
     httplib::SSLClient tls("127.0.0.1", share.port);
     tls.set_ca_cert_path(cert.c_str());
     tls.enable_server_certificate_verification(true);
@@ -150,5 +143,5 @@ TEST(ShareCli, ServesHttpsWithTheOperatorsCertificate) {
     kill(share.pid, SIGTERM);
     int status = 0;
     waitpid(share.pid, &status, 0);
-    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << readText(share.log);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << readFileBytes(share.log);
 }

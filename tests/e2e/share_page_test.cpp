@@ -33,23 +33,6 @@ using namespace std::chrono_literals;
 
 namespace {
 
-std::string readText(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-CommandResult shell(const std::string& cmd) {
-    CommandResult r;
-    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-    char buffer[4096];
-    while (std::fgets(buffer, sizeof buffer, pipe)) r.output += buffer;
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
-
 // A loopback port nobody listens on now (bound to port 0, read back, closed).
 int freePort() {
     const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
@@ -67,7 +50,7 @@ int freePort() {
 
 TEST(SharePage, QrCodeOpensTheAvatarPageInChromium) {
     for (const char* tool : {"zbarimg", "node", "/usr/bin/chromium"})
-        if (shell(std::string("command -v ") + tool).exitCode != 0) GTEST_SKIP() << tool << " is not installed";
+        if (runShell(std::string("command -v ") + tool + " 2>&1").exitCode != 0) GTEST_SKIP() << tool << " is not installed";
     const fs::path browser = fs::path(AVATARBOOTH_TEST_SOURCE_DIR) / "tests/browser";
     if (!fs::is_directory(browser / "node_modules/puppeteer-core")) GTEST_SKIP() << "puppeteer-core (npm) is not installed";
 
@@ -101,7 +84,7 @@ TEST(SharePage, QrCodeOpensTheAvatarPageInChromium) {
     thanks.shareUrl = avatarbooth::sharePageUrl(share, avatarbooth::readShareToken(session).value_or(""));
     cv::imwrite((dir / "thanks.png").string(), screens.draw(thanks, {}));
     // (zbarimg's complaints about a missing D-Bus go to stderr: not part of the URL.)
-    const CommandResult qr = shell("(zbarimg --raw -q " + (dir / "thanks.png").string() + " 2>/dev/null)");
+    const CommandResult qr = runShell("(zbarimg --raw -q " + (dir / "thanks.png").string() + " 2>/dev/null) 2>&1");
     ASSERT_EQ(qr.exitCode, 0) << qr.output;
     const std::string url = std::regex_replace(qr.output, std::regex("\\s+$"), "");
     ASSERT_TRUE(std::regex_match(url, std::regex(base + "/s/[0-9a-f]{32}"))) << url;
@@ -118,13 +101,13 @@ TEST(SharePage, QrCodeOpensTheAvatarPageInChromium) {
         execl(bin.c_str(), bin.c_str(), "share", "--config", config.c_str(), static_cast<char*>(nullptr));
         _exit(127);
     }
-    for (int i = 0; i < 250 && readText(log).find("listening on") == std::string::npos; ++i) std::this_thread::sleep_for(20ms);
-    const CommandResult page = shell("cd " + browser.string() + " && node check_share_page.mjs '" + url + "' " +
-                                     (dir / "page.png").string());
+    for (int i = 0; i < 250 && readFileBytes(log).find("listening on") == std::string::npos; ++i) std::this_thread::sleep_for(20ms);
+    const CommandResult page = runShell("cd " + browser.string() + " && node check_share_page.mjs '" + url + "' " +
+                                        (dir / "page.png").string() + " 2>&1");
     kill(pid, SIGTERM);
     int status = 0;
     waitpid(pid, &status, 0);
     std::printf("[ figures ] the page in Chromium (loopback, 390x844 phone): %s\n", page.output.c_str());
-    EXPECT_EQ(page.exitCode, 0) << page.output << readText(log);
+    EXPECT_EQ(page.exitCode, 0) << page.output << readFileBytes(log);
     EXPECT_NE(page.output.find("\"ok\":true"), std::string::npos) << page.output;
 }

@@ -40,13 +40,6 @@ CommandResult shell(const std::string& cmd) {
     return r;
 }
 
-std::string readText(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
 // The tools come from Debian packages tests/setup.sh installs; a missing one is a failed test, not a skip.
 void requireTool(const std::string& tool, const std::string& package) {
     ASSERT_EQ(shell("command -v " + tool).exitCode, 0) << tool << " is missing: apt-get install " << package;
@@ -54,14 +47,14 @@ void requireTool(const std::string& tool, const std::string& package) {
 
 // A unit as installed, but starting the binary just built (verify checks that ExecStart exists).
 fs::path unitForVerify(const fs::path& dir, const std::string& name = "avatarbooth.service") {
-    std::string unit = readText(kSource / "systemd" / name);
+    std::string unit = readFileBytes(kSource / "systemd" / name);
     unit = std::regex_replace(unit, std::regex("/usr/bin/avatarbooth"), binary().string());
     const fs::path out = dir / name;
     std::ofstream(out) << unit;
     return out;
 }
 
-std::string mode(const fs::path& p) {
+std::string modeString(const fs::path& p) {
     struct stat st {};
     if (::stat(p.c_str(), &st) != 0) return "missing";
     char buf[8];
@@ -85,7 +78,7 @@ TEST(ApplianceSystemd, EveryUnitVerifies) {
 }
 
 TEST(ApplianceSystemd, ServiceUnitIsNotifyWithWatchdogAndRestart) {
-    const std::string unit = readText(kSource / "systemd/avatarbooth.service");
+    const std::string unit = readFileBytes(kSource / "systemd/avatarbooth.service");
     EXPECT_NE(unit.find("\nType=notify\n"), std::string::npos);
     EXPECT_NE(unit.find("\nRestart=always\n"), std::string::npos);
     EXPECT_NE(unit.find("\nUser=avatarbooth\n"), std::string::npos);
@@ -102,7 +95,7 @@ TEST(ApplianceSystemd, ServiceUnitIsNotifyWithWatchdogAndRestart) {
 // The share service (issue 23): off unless enabled, not restarted when booth.toml says sharing is off (exit 6), and
 // sandboxed to reading the sessions folder and listening on the web ports.
 TEST(ApplianceSystemd, ShareUnitMayOnlyReadTheSessionsAndListen) {
-    const std::string unit = readText(kSource / "systemd/avatarbooth-share.service");
+    const std::string unit = readFileBytes(kSource / "systemd/avatarbooth-share.service");
     EXPECT_NE(unit.find("\nExecStart=/usr/bin/avatarbooth share --config /etc/avatarbooth/booth.toml\n"), std::string::npos);
     EXPECT_NE(unit.find("\nType=notify\n"), std::string::npos);
     EXPECT_NE(unit.find("\nRestartPreventExitStatus=6\n"), std::string::npos);
@@ -115,7 +108,7 @@ TEST(ApplianceSystemd, ShareUnitMayOnlyReadTheSessionsAndListen) {
     EXPECT_NE(unit.find("\nSocketBindDeny=any\n"), std::string::npos);
     EXPECT_NE(unit.find("\nCapabilityBoundingSet=CAP_NET_BIND_SERVICE\n"), std::string::npos);
     // The kiosk stays off the network.
-    EXPECT_NE(readText(kSource / "systemd/avatarbooth.service").find("\nPrivateNetwork=yes\n"), std::string::npos);
+    EXPECT_NE(readFileBytes(kSource / "systemd/avatarbooth.service").find("\nPrivateNetwork=yes\n"), std::string::npos);
 }
 
 TEST(ApplianceSystemd, SecurityExposureAtMostTwo) {
@@ -143,8 +136,8 @@ TEST(ApplianceSystemd, TmpfilesAndSysusersMakeTheUserAndItsFolder) {
     // sysusers.d first, as the package's postinst does: it makes the user tmpfiles.d gives the folder to.
     CommandResult r = shell("systemd-sysusers --root=" + root.string() + " " + (kSource / "systemd/avatarbooth.sysusers").string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
-    const std::string passwd = readText(root / "etc/passwd");
-    const std::string group = readText(root / "etc/group");
+    const std::string passwd = readFileBytes(root / "etc/passwd");
+    const std::string group = readFileBytes(root / "etc/group");
     EXPECT_TRUE(std::regex_search(passwd, std::regex("(^|\n)avatarbooth:x:[0-9]+:[0-9]+:[^:]*:/var/lib/avatarbooth:/usr/sbin/nologin\n")))
         << passwd;
     for (const char* g : {"video", "gpio", "render", "input"})
@@ -152,10 +145,10 @@ TEST(ApplianceSystemd, TmpfilesAndSysusersMakeTheUserAndItsFolder) {
 
     r = shell("systemd-tmpfiles --root=" + root.string() + " --create " + (kSource / "systemd/avatarbooth.tmpfiles").string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
-    EXPECT_EQ(mode(root / "var/lib/avatarbooth"), "0750");
-    EXPECT_EQ(mode(root / "var/lib/avatarbooth/sessions"), "0750");
+    EXPECT_EQ(modeString(root / "var/lib/avatarbooth"), "0750");
+    EXPECT_EQ(modeString(root / "var/lib/avatarbooth/sessions"), "0750");
     // The cache of the converted landmark model, the booth user's alone (fit/face/model_cache.h looks there).
-    EXPECT_EQ(mode(root / "var/cache/avatarbooth"), "0700");
+    EXPECT_EQ(modeString(root / "var/cache/avatarbooth"), "0700");
     // The sessions folder of tmpfiles.d is the one booth.toml ships.
     const BoothConfig shipped = loadBoothConfig(kSource / "app/assets/booth.toml");
     EXPECT_EQ(shipped.sessions.directory, fs::path("/var/lib/avatarbooth/sessions"));
@@ -195,14 +188,14 @@ TEST(ApplianceFirmware, OverlayCompilesWithoutWarningsAndMatchesTheConfig) {
     EXPECT_EQ(pins.output, want.str() + "\n");
 
     // The boot config fragment passes the same numbers as overlay parameters.
-    const std::string fragment = readText(kSource / "firmware/config.txt.fragment");
+    const std::string fragment = readFileBytes(kSource / "firmware/config.txt.fragment");
     std::ostringstream line;
     line << "dtoverlay=avatarbooth,start=" << expected[0] << ",retake=" << expected[1] << ",start_lamp=" << expected[2]
          << ",retake_lamp=" << expected[3] << ",flash_lamp=" << expected[4] << "\n";
     EXPECT_NE(fragment.find(line.str()), std::string::npos) << "expected in config.txt.fragment: " << line.str();
 
     // The README's wiring table names the same BCM numbers ("| start button | BCM 17 | ...").
-    const std::string readme = readText(kSource / "README.md");
+    const std::string readme = readFileBytes(kSource / "README.md");
     const std::vector<std::string> rows = {"start button", "retake button", "start lamp", "retake lamp", "flash lamp"};
     for (std::size_t i = 0; i < rows.size(); ++i)
         EXPECT_NE(readme.find("| " + rows[i] + " | BCM " + std::to_string(expected[i]) + " |"), std::string::npos)
@@ -224,7 +217,7 @@ TEST(ApplianceFirmware, OverlayParametersMoveThePins) {
 }
 
 TEST(ApplianceFirmware, UdevRulesCoverTheBoothsDevices) {
-    const std::string rules = readText(kSource / "firmware/60-avatarbooth.rules");
+    const std::string rules = readFileBytes(kSource / "firmware/60-avatarbooth.rules");
     const std::vector<std::pair<std::string, std::string>> wanted = {
         {"KERNEL==\"gpiochip[0-9]*\"", "GROUP=\"gpio\""},  {"KERNEL==\"video[0-9]*\"", "GROUP=\"video\""},
         {"KERNEL==\"media[0-9]*\"", "GROUP=\"video\""},    {"KERNEL==\"card[0-9]*\"", "GROUP=\"video\""},

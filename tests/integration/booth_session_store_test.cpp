@@ -43,7 +43,7 @@ void writeFit(const fs::path& dir) {
     staged.commit();
 }
 
-unsigned mode(const fs::path& p) {
+unsigned permissionsOf(const fs::path& p) {
     struct stat st {};
     EXPECT_EQ(::stat(p.c_str(), &st), 0) << p;
     return st.st_mode & 07777;
@@ -112,9 +112,9 @@ TEST(SessionStore, KeepMovesTheFitUnderItsCodeReadableOnlyByTheBooth) {
     std::set<std::string> expected{"session.json"};
     for (const auto& [name, size] : kFitFiles) expected.insert(name);
     EXPECT_EQ(filesIn(kept), expected);
-    EXPECT_EQ(mode(dir / "sessions"), 0700u);
-    EXPECT_EQ(mode(kept), 0700u);
-    for (const auto& name : expected) EXPECT_EQ(mode(kept / name), 0600u) << name;
+    EXPECT_EQ(permissionsOf(dir / "sessions"), 0700u);
+    EXPECT_EQ(permissionsOf(kept), 0700u);
+    for (const auto& name : expected) EXPECT_EQ(permissionsOf(kept / name), 0600u) << name;
 
     std::ifstream in(kept / "session.json");
     const std::string info((std::istreambuf_iterator<char>(in)), {});

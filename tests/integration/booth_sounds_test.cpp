@@ -16,7 +16,6 @@
 using namespace avatarbooth;
 using namespace avatarbooth::test;
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
@@ -79,7 +78,7 @@ TEST(BoothSounds, RecordedWavHasTheBeepsAtTheCountdownsTimes) {
     const fs::path wav = dir / "booth.wav";
     std::string note;
     std::vector<double> asked;  // seconds after the stream's start
-    Clock::time_point started;
+    std::chrono::steady_clock::time_point started;
     {
         auto sounds = BoothSounds::open(recordingInto(wav), note);
         ASSERT_TRUE(sounds) << note;
@@ -92,8 +91,8 @@ TEST(BoothSounds, RecordedWavHasTheBeepsAtTheCountdownsTimes) {
             {1.50, screenOf(ScreenId::CaptureFlash)}, {2.10, screenOf(ScreenId::Processing)},
             {2.20, screenOf(ScreenId::Reveal)}};
         for (const auto& [at, screen] : script) {
-            std::this_thread::sleep_until(started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(at)));
-            const auto now = Clock::now();
+            std::this_thread::sleep_until(started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(at)));
+            const auto now = std::chrono::steady_clock::now();
             sounds->screen(screen, now);
             if (screen.id != ScreenId::FrontGuide && screen.id != ScreenId::Processing)
                 asked.push_back(std::chrono::duration<double>(now - started).count());
@@ -136,7 +135,7 @@ TEST(BoothSounds, CountdownBeepsKeepTheirRhythmWhenTheLoopIsLate) {
     const fs::path dir = scratchDir("booth_sounds_late");
     const fs::path wav = dir / "late.wav";
     std::string note;
-    Clock::time_point started;
+    std::chrono::steady_clock::time_point started;
     {
         auto sounds = BoothSounds::open(recordingInto(wav), note);
         if (!sounds && !haveTheme()) GTEST_SKIP() << "sound-theme-freedesktop is not installed (tests/setup.sh installs it)";
@@ -155,10 +154,10 @@ TEST(BoothSounds, CountdownBeepsKeepTheirRhythmWhenTheLoopIsLate) {
                                        {3.30, ScreenId::CaptureFlash, 0, 0}, {3.40, ScreenId::SideGuide, 0, 0},
                                        {4.30, ScreenId::Countdown, 3, 0},   {4.80, ScreenId::SideGuide, 0, 0}};
         for (const Step& step : script) {
-            std::this_thread::sleep_until(started + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(step.at)));
+            std::this_thread::sleep_until(started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(step.at)));
             ScreenModel screen = screenOf(step.id, step.number);
             screen.countdownAge = Millis(step.ageMs);
-            sounds->screen(screen, Clock::now());
+            sounds->screen(screen, std::chrono::steady_clock::now());
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(1300));  // past where the abandoned "2" would sound
     }

@@ -35,7 +35,6 @@
 using namespace avatarbooth;
 using namespace avatarbooth::test;
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 using Seconds = std::chrono::duration<double>;
 
 namespace {
@@ -163,10 +162,10 @@ struct Heard {
 };
 Heard waitFor(KioskQueue& queue, const std::string& pattern, Seconds limit) {
     Heard h;
-    const auto t0 = Clock::now();
+    const auto t0 = std::chrono::steady_clock::now();
     const std::regex re(pattern);
-    while (Clock::now() - t0 < limit) {
-        auto m = queue.waitUntil(Clock::now() + std::chrono::milliseconds(100));
+    while (std::chrono::steady_clock::now() - t0 < limit) {
+        auto m = queue.waitUntil(std::chrono::steady_clock::now() + std::chrono::milliseconds(100));
         if (!m) continue;
         if (const auto* s = std::get_if<PrintStatus>(&*m)) {
             h.all.push_back(*s);
@@ -176,7 +175,7 @@ Heard waitFor(KioskQueue& queue, const std::string& pattern, Seconds limit) {
             }
         }
     }
-    h.seconds = Seconds(Clock::now() - t0).count();
+    h.seconds = Seconds(std::chrono::steady_clock::now() - t0).count();
     return h;
 }
 std::string lines(const Heard& h) {
@@ -200,9 +199,9 @@ TEST(PrintCard, LaidOutOnOne100x148PageWithCodeQrAndTheThreeStyles) {
     const fs::path dir = test::scratchDir("print_card_layout");
     const Kept kept = keepSession(dir / "sessions");
     PrintSettings settings = cardSettings("");
-    const auto t0 = Clock::now();
+    const auto t0 = std::chrono::steady_clock::now();
     const std::string pdf = renderCardPdf(readCardContent(kept.folder, kept.code, kept.url, settings), settings);
-    std::printf("card laid out: %zu KB of PDF in %.3f s\n", pdf.size() / 1024, Seconds(Clock::now() - t0).count());
+    std::printf("card laid out: %zu KB of PDF in %.3f s\n", pdf.size() / 1024, Seconds(std::chrono::steady_clock::now() - t0).count());
     writeFileAtomically(dir / "card.pdf", pdf);
     expectCard(dir / "card.pdf", kept);
 }
@@ -232,14 +231,14 @@ TEST(PrintCard, AFolderWithoutItsPreviewIsRefusedNamingTheFile) {
 TEST(PrintCups, NoSchedulerIsReportedAtOnce) {
     setenv("CUPS_SERVER", "/nonexistent/avatarbooth/cups.sock", 1);
     cupsSetServer(nullptr);
-    const auto t0 = Clock::now();
+    const auto t0 = std::chrono::steady_clock::now();
     const QueueState q = queryQueue("booth");
     unsetenv("CUPS_SERVER");
     cupsSetServer(nullptr);
     EXPECT_FALSE(q.found());
     EXPECT_TRUE(q.problem());
     EXPECT_NE(q.describe().find("no CUPS scheduler"), std::string::npos) << q.describe();
-    EXPECT_LT(Seconds(Clock::now() - t0).count(), 5.0);
+    EXPECT_LT(Seconds(std::chrono::steady_clock::now() - t0).count(), 5.0);
 }
 
 TEST(PrintCups, KeptSessionsCardComesOutOfCupsPdfAndItsTimeIsPrinted) {
@@ -255,9 +254,9 @@ TEST(PrintCups, KeptSessionsCardComesOutOfCupsPdfAndItsTimeIsPrinted) {
 
     KioskQueue messages;
     PrintWorker worker(cardSettings(cups.queue()), messages, std::chrono::milliseconds(200));
-    const auto t0 = Clock::now();
+    const auto t0 = std::chrono::steady_clock::now();
     worker.print({kept.folder, kept.code, kept.url});
-    const double returned = Seconds(Clock::now() - t0).count();
+    const double returned = Seconds(std::chrono::steady_clock::now() - t0).count();
     const Heard h = waitFor(messages, ": printed", Seconds(60));
     ASSERT_TRUE(h.found) << lines(h) << cups.log();
     // cups-pdf names the file after the job's title.
@@ -267,7 +266,7 @@ TEST(PrintCups, KeptSessionsCardComesOutOfCupsPdfAndItsTimeIsPrinted) {
             if (e.path().extension() == ".pdf") pdf = e.path();
         if (pdf.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
-    const double toPdf = Seconds(Clock::now() - t0).count();
+    const double toPdf = Seconds(std::chrono::steady_clock::now() - t0).count();
     ASSERT_FALSE(pdf.empty()) << "cups-pdf wrote nothing\n" << lines(h) << cups.log();
     std::printf("card print time to PDF (keep -> cups-pdf's file, incl. card layout, CUPS filters, Ghostscript): "
                 "%.2f s; print() returned in %.4f s\n%s",

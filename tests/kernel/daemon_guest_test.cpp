@@ -7,6 +7,7 @@
 // NOTIFY_SOCKET -- also while the screen is switched off (vkms's connector forced off) and after it comes back by
 // itself, until SIGTERM, which ends it promptly with exit code 0 although the model load has not finished.
 #include "kernel_guest.h"
+#include "vivid_node.h"
 #include "kiosk_daemon_checks.h"
 #include "kms_scanout.h"
 
@@ -37,6 +38,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
+using kernel_test::vividNode;
 using kernel_test::readFile;
 using kernel_test::writeFile;
 using test::NotifySocket;
@@ -46,14 +48,6 @@ constexpr const char* kLabel = "avatarbooth-daemon";
 // The shipped unit's WatchdogSec (systemd/avatarbooth.service): a ping every 5 s while the main loop runs. (Under
 // emulation an attract frame takes 2-5 s, so a stricter watchdog would test the emulator, not the booth.)
 constexpr int kWatchdogUsec = 10000000;
-
-std::string vividNode() {
-    for (const auto& node : listV4l2Nodes()) {
-        const V4l2DeviceInfo info = probeV4l2Device(node);
-        if (info.driver == "vivid" && info.canCapture) return node;
-    }
-    return "";
-}
 
 double secondsSince(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();

@@ -25,8 +25,8 @@ using namespace std::chrono_literals;
 using kernel_test::readFile;
 using kernel_test::writeFile;
 
-constexpr const char* kLabel = "avatarbooth-sim";
-const fs::path kConfig = "/sys/kernel/config/gpio-sim/avatarbooth";
+constexpr const char* kSimLabel = "avatarbooth-sim";
+const fs::path kSimConfig = "/sys/kernel/config/gpio-sim/avatarbooth";
 
 class GpioSim : public ::testing::Test {
 protected:
@@ -37,12 +37,12 @@ protected:
         // configfs is a module in Debian's kernel, loaded with gpio-sim: mount it now.
         kernel_test::run("mountpoint -q /sys/kernel/config || mount -t configfs none /sys/kernel/config");
         if (!fs::exists("/sys/kernel/config/gpio-sim")) return;
-        fs::create_directories(kConfig / "bank0");
-        if (!writeFile(kConfig / "bank0/num_lines", "8") || !writeFile(kConfig / "bank0/label", kLabel) ||
-            !writeFile(kConfig / "live", "1"))
+        fs::create_directories(kSimConfig / "bank0");
+        if (!writeFile(kSimConfig / "bank0/num_lines", "8") || !writeFile(kSimConfig / "bank0/label", kSimLabel) ||
+            !writeFile(kSimConfig / "live", "1"))
             return;
-        chip_ = readFile(kConfig / "bank0/chip_name");
-        sim_ = fs::path("/sys/devices/platform") / readFile(kConfig / "dev_name") / chip_;
+        chip_ = readFile(kSimConfig / "bank0/chip_name");
+        sim_ = fs::path("/sys/devices/platform") / readFile(kSimConfig / "dev_name") / chip_;
         ready_ = !chip_.empty() && fs::exists(sim_ / "sim_gpio0/pull");
     }
     void SetUp() override {
@@ -51,7 +51,7 @@ protected:
         // Buttons idle: the line pulled up, as the button's pull-up holds it on the board.
         for (int line = 0; line < 2; ++line) ASSERT_TRUE(pull(line, true));
         settings_.backend = "gpiod";
-        settings_.chip = kLabel;
+        settings_.chip = kSimLabel;
         settings_.buttons = {{"start", 0}, {"retake", 1}};
         settings_.lamps = {{"start", 4}, {"retake", 5}, {"flash", 6, true}};
         settings_.debounceMs = 80;
@@ -154,14 +154,14 @@ TEST_F(GpioSim, AMissingChipIsAClearDeviceError) {
         EXPECT_NE(std::string(e.what()).find(chip_), std::string::npos) << e.what();
     }
     std::string why;
-    EXPECT_TRUE(gpiodChipAvailable(kLabel, &why)) << why;
+    EXPECT_TRUE(gpiodChipAvailable(kSimLabel, &why)) << why;
 }
 
 TEST_F(GpioSim, ALineAlreadyInUseIsAClearDeviceErrorNamingItsUser) {
     SteadyClock clock;
     ButtonBoard board = openButtonBoard(settings_, clock);
     try {
-        openGpiodInputLines(kLabel, {{0, LineBias::PullUp, "second start button"}}, "intruder");
+        openGpiodInputLines(kSimLabel, {{0, LineBias::PullUp, "second start button"}}, "intruder");
         FAIL() << "requested a line that is in use";
     } catch (const BoothError& e) {
         EXPECT_EQ(e.kind(), ErrorKind::Device);
@@ -170,7 +170,7 @@ TEST_F(GpioSim, ALineAlreadyInUseIsAClearDeviceErrorNamingItsUser) {
             << e.what();
     }
     try {
-        openGpiodOutputLines(kLabel, {{4, false, "second lamp"}}, "intruder");
+        openGpiodOutputLines(kSimLabel, {{4, false, "second lamp"}}, "intruder");
         FAIL() << "requested a lamp line that is in use";
     } catch (const BoothError& e) {
         EXPECT_NE(std::string(e.what()).find("already in use"), std::string::npos) << e.what();
@@ -200,13 +200,13 @@ TEST_F(GpioSim, TheChipOpensByPathNameAndNumberAsByLabel) {
         settings_.chip = name;
         SteadyClock clock;
         ButtonBoard board = openButtonBoard(settings_, clock);
-        EXPECT_NE(board.description.find(std::string("[") + kLabel + "]"), std::string::npos) << board.description;
+        EXPECT_NE(board.description.find(std::string("[") + kSimLabel + "]"), std::string::npos) << board.description;
     }
 }
 
 TEST_F(GpioSim, ALineTheChipDoesNotHaveIsAClearDeviceError) {
     try {
-        openGpiodInputLines(kLabel, {{9, LineBias::PullUp, "start button"}}, "avatarbooth-test");
+        openGpiodInputLines(kSimLabel, {{9, LineBias::PullUp, "start button"}}, "avatarbooth-test");
         FAIL() << "requested line 9 of an 8-line chip";
     } catch (const BoothError& e) {
         EXPECT_EQ(e.kind(), ErrorKind::Device);
@@ -223,7 +223,7 @@ TEST_F(GpioSim, TheKernelDebouncesTheButtonLinesWhereLibgpiodCan) {
     SteadyClock clock;
     ButtonBoard board = openButtonBoard(settings_, clock);
     std::string chipName;
-    const auto lines = gpiodLineStatus(kLabel, {0, 1, 4}, &chipName);
+    const auto lines = gpiodLineStatus(kSimLabel, {0, 1, 4}, &chipName);
     ASSERT_EQ(lines.size(), 3u);
     const auto expected = gpiodKernelDebounce() ? std::chrono::microseconds(5000) : std::chrono::microseconds(0);
     for (int i : {0, 1}) {

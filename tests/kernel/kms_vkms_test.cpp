@@ -27,7 +27,6 @@ namespace avatarbooth {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 // The mode tests/kernel/run.sh asks for on the guest's command line (video=Virtual-1:640x360@60): the booth's
 // small test screen, and a mode vkms does not list itself (the kernel adds it from the command line).
@@ -89,9 +88,9 @@ double median(std::vector<double> v) {
 }
 
 TEST_F(Vkms, KmsDisplayScansOutItsFramesExactlyAndTheWritebackReadsThemBack) {
-    const auto opening = Clock::now();
+    const auto opening = std::chrono::steady_clock::now();
     KmsDisplay display(settings_);
-    const double openSeconds = std::chrono::duration<double>(Clock::now() - opening).count();
+    const double openSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - opening).count();
     std::printf("[vkms] %s, opened in %.2f s\n", display.describe().c_str(), openSeconds);
     EXPECT_EQ(display.size(), kPanel) << "not the mode of the kernel's video= (USERDEF): " << display.describe();
     EXPECT_NE(display.describe().find(card_ + " Virtual-1"), std::string::npos) << display.describe();
@@ -122,11 +121,11 @@ TEST_F(Vkms, PageFlipsLandOnTheRefreshAndPaceTheFrames) {
     const cv::Mat a = testCard(display.size(), 0), b = testCard(display.size(), 1);
     display.present(a);  // the mode set
     std::vector<KmsDisplay::Flip> flips;
-    std::vector<Clock::time_point> returned;
+    std::vector<std::chrono::steady_clock::time_point> returned;
     constexpr int kFrames = 40;
     for (int i = 0; i < kFrames; ++i) {
         display.present(i % 2 ? a : b);
-        returned.push_back(Clock::now());
+        returned.push_back(std::chrono::steady_clock::now());
         flips.push_back(display.lastFlip());
     }
     // The kernel's own record: each flip on a later refresh than the one before, and its time that many refresh
@@ -221,8 +220,8 @@ TEST_F(Vkms, AnUnpluggedScreenIsADeviceErrorAndAReplugGivesItBack) {
 template <typename Done>
 int presentUntil(Display& display, const cv::Mat& frame, Done done, std::chrono::milliseconds limit) {
     int frames = 0;
-    for (const auto end = Clock::now() + limit; !done() && Clock::now() < end; ++frames) {
-        const auto next = Clock::now() + std::chrono::milliseconds(33);
+    for (const auto end = std::chrono::steady_clock::now() + limit; !done() && std::chrono::steady_clock::now() < end; ++frames) {
+        const auto next = std::chrono::steady_clock::now() + std::chrono::milliseconds(33);
         display.present(frame);
         std::this_thread::sleep_until(next);
     }
@@ -243,7 +242,7 @@ TEST_F(Vkms, TheKioskScreenSwitchedOffAndOnComesBackByItself) {
     ASSERT_TRUE(display.status().ok);
 
     ASSERT_TRUE(kernel_test::writeFile(status_, "off"));
-    const auto off = Clock::now();
+    const auto off = std::chrono::steady_clock::now();
     const int whileOff = presentUntil(display, before, [] { return false; }, std::chrono::milliseconds(3000));
     DisplayStatus s = display.status();
     EXPECT_FALSE(s.ok);
@@ -255,13 +254,13 @@ TEST_F(Vkms, TheKioskScreenSwitchedOffAndOnComesBackByItself) {
     EXPECT_EQ(display.current(), nullptr);
     EXPECT_EQ(display.size(), kPanel);
     std::printf("[vkms] screen off: %d frames presented in %.1f s without it, %d reopens failed: %s\n", whileOff,
-                std::chrono::duration<double>(Clock::now() - off).count(), s.failedReopens, s.lastError.c_str());
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - off).count(), s.failedReopens, s.lastError.c_str());
 
     ASSERT_TRUE(kernel_test::writeFile(status_, "detect"));
-    const auto on = Clock::now();
+    const auto on = std::chrono::steady_clock::now();
     const cv::Mat after = testCard(display.size(), 1);
     presentUntil(display, after, [&] { return display.status().ok; }, std::chrono::milliseconds(6000));
-    const double backSeconds = std::chrono::duration<double>(Clock::now() - on).count();
+    const double backSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - on).count();
     s = display.status();
     ASSERT_TRUE(s.ok) << s.lastError;
     EXPECT_EQ(s.recoveries, 1);

@@ -2,6 +2,7 @@
 // (sizes, sequence numbers, timestamps, colour bars after our YUYV conversion), stills, and recovery when vivid's
 // disconnect control pulls the device away while streaming.
 #include "kernel_guest.h"
+#include "vivid_node.h"
 
 #include "drivers/camera/camera_factory.h"
 #include "drivers/camera/frame_conversion.h"
@@ -20,15 +21,7 @@ namespace avatarbooth {
 namespace {
 
 using namespace std::chrono_literals;
-
-// The vivid capture node (the node numbers depend on what else is loaded), or "" when there is none.
-std::string vividNode() {
-    for (const auto& node : listV4l2Nodes()) {
-        const V4l2DeviceInfo info = probeV4l2Device(node);
-        if (info.driver == "vivid" && info.canCapture) return node;
-    }
-    return "";
-}
+using kernel_test::vividNode;
 
 class Vivid : public ::testing::Test {
 protected:

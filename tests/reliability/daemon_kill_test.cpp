@@ -29,15 +29,9 @@
 namespace fs = std::filesystem;
 using namespace avatarbooth;
 using namespace avatarbooth::reliability;
-using Clock = std::chrono::steady_clock;
 using Seconds = std::chrono::duration<double>;
 
 namespace {
-
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
 
 std::size_t count(const std::string& text, const std::string& what) {
     std::size_t n = 0;
@@ -67,10 +61,10 @@ public:
     }
     // Waits for a datagram holding READY=1; false on timeout.
     bool waitReady(std::chrono::milliseconds timeout) {
-        const auto end = Clock::now() + timeout;
-        while (Clock::now() < end) {
+        const auto end = std::chrono::steady_clock::now() + timeout;
+        while (std::chrono::steady_clock::now() < end) {
             pollfd p{fd_, POLLIN, 0};
-            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - Clock::now()).count();
+            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count();
             if (::poll(&p, 1, static_cast<int>(std::max<long>(1, left))) <= 0) continue;
             char buf[4096];
             const ssize_t n = ::recv(fd_, buf, sizeof buf - 1, 0);
@@ -86,12 +80,12 @@ private:
 
 struct Daemon {
     pid_t pid = -1;
-    Clock::time_point started;
+    std::chrono::steady_clock::time_point started;
 };
 
 Daemon spawnDaemon(const fs::path& config, const fs::path& log, const NotifySocket& notify) {
     Daemon d;
-    d.started = Clock::now();
+    d.started = std::chrono::steady_clock::now();
     d.pid = ::fork();
     if (d.pid == 0) {
         const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0600);
@@ -138,18 +132,18 @@ TEST(DaemonKill, KilledWhileWritingLeavesOnlyCompleteSessionsAndRestartsFast) {
     const int kills = 6;
     std::size_t fitsSeen = 0;
     Daemon d = spawnDaemon(config, log, notify);
-    ASSERT_TRUE(notify.waitReady(std::chrono::seconds(30))) << readFile(log);
+    ASSERT_TRUE(notify.waitReady(std::chrono::seconds(30))) << test::readFileBytes(log);
     std::size_t keepsSeen = 0;
     for (int k = 0; k < kills; ++k) {
         // In turn: killed while the fit's files are being staged, at a random moment from the fit's start, or just
         // after a keep (while the kept session's toon is drawn and its strip written: the keep does not wait for it).
         enum class When { Staging, AfterFit, AfterKeep } when = static_cast<When>(k % 3);
-        const auto deadline = Clock::now() + std::chrono::seconds(60);
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
         bool due = false;
-        while (Clock::now() < deadline && !due) {
+        while (std::chrono::steady_clock::now() < deadline && !due) {
             if (when == When::Staging) due = writingNow(sessions);
-            else if (when == When::AfterFit) due = count(readFile(log), "] fitting the photos") > fitsSeen;
-            else due = count(readFile(log), "session kept as") > keepsSeen;
+            else if (when == When::AfterFit) due = count(test::readFileBytes(log), "] fitting the photos") > fitsSeen;
+            else due = count(test::readFileBytes(log), "session kept as") > keepsSeen;
             notify.drain();
             if (!due) std::this_thread::sleep_for(std::chrono::milliseconds(when == When::Staging ? 1 : 20));
         }
@@ -157,9 +151,9 @@ TEST(DaemonKill, KilledWhileWritingLeavesOnlyCompleteSessionsAndRestartsFast) {
             ::kill(d.pid, SIGKILL);
             ::waitpid(d.pid, nullptr, 0);
         }
-        ASSERT_TRUE(due) << "no fit or keep seen in 60 s: " << readFile(log);
-        fitsSeen = count(readFile(log), "] fitting the photos");
-        keepsSeen = count(readFile(log), "session kept as");
+        ASSERT_TRUE(due) << "no fit or keep seen in 60 s: " << test::readFileBytes(log);
+        fitsSeen = count(test::readFileBytes(log), "] fitting the photos");
+        keepsSeen = count(test::readFileBytes(log), "session kept as");
         const int maxDelayMs = when == When::Staging ? 120 : when == When::AfterFit ? 2500 : 1500;
         const int delayMs = std::uniform_int_distribution<int>(0, maxDelayMs)(rng);
         std::this_thread::sleep_for(std::chrono::milliseconds(delayMs));
@@ -190,15 +184,15 @@ TEST(DaemonKill, KilledWhileWritingLeavesOnlyCompleteSessionsAndRestartsFast) {
         if (!notify.waitReady(std::chrono::seconds(30))) {
             ::kill(d.pid, SIGKILL);
             ::waitpid(d.pid, nullptr, 0);
-            FAIL() << "no READY=1 within 30 s of the restart: " << readFile(log);
+            FAIL() << "no READY=1 within 30 s of the restart: " << test::readFileBytes(log);
         }
-        readySeconds.push_back(Seconds(Clock::now() - d.started).count());
+        readySeconds.push_back(Seconds(std::chrono::steady_clock::now() - d.started).count());
         EXPECT_EQ(checkSessions(sessions).leftovers, 0) << "the restarted booth did not clear the killed one's leftovers";
     }
     // The last one ends normally once it has kept a session.
-    const std::size_t keptBefore = count(readFile(log), "session kept as");
-    const auto deadline = Clock::now() + std::chrono::seconds(90);
-    while (Clock::now() < deadline && count(readFile(log), "session kept as") == keptBefore) {
+    const std::size_t keptBefore = count(test::readFileBytes(log), "session kept as");
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(90);
+    while (std::chrono::steady_clock::now() < deadline && count(test::readFileBytes(log), "session kept as") == keptBefore) {
         notify.drain();
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }

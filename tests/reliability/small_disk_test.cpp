@@ -20,11 +20,6 @@ using namespace avatarbooth::reliability;
 
 namespace {
 
-std::string readFile(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 }  // namespace
 
 TEST(SmallDisk, FullFilesystemWhileWritingThenSpaceFreed) {
@@ -66,10 +61,10 @@ cp -a "$mnt/sessions" "$out/sessions"
     const std::string cmd = "unshare -rm bash '" + script.string() + "' '" + mnt.string() + "' '" +
                             test::binary().string() + "' '" + config.string() + "' '" + dir.string() + "' 2>&1";
     const int rc = std::system(cmd.c_str());
-    const std::string log = readFile(dir / "daemon.log");
+    const std::string log = test::readFileBytes(dir / "daemon.log");
     ASSERT_EQ(rc, 0) << "the namespace script failed (" << rc << "): " << log;
     EXPECT_NE(log.find("No space left on device"), std::string::npos) << log;
-    EXPECT_EQ(readFile(dir / "exit_code"), "0\n") << log;
+    EXPECT_EQ(test::readFileBytes(dir / "exit_code"), "0\n") << log;
 
     const SessionsCheck c = checkSessions(dir / "sessions");
     for (const auto& p : c.problems) ADD_FAILURE() << p;
@@ -81,8 +76,8 @@ cp -a "$mnt/sessions" "$out/sessions"
             EXPECT_TRUE(validateGlb(dir / "sessions" / code / "avatar.glb", &report)) << report;
         }
     }
-    const double freed = std::stod(readFile(dir / "freed_at"));
-    const double kept = std::stod(readFile(dir / "kept_at"));
+    const double freed = std::stod(test::readFileBytes(dir / "freed_at"));
+    const double kept = std::stod(test::readFileBytes(dir / "kept_at"));
     std::printf("figure: small filesystem full -> fit refused with ENOSPC, nothing partial; next session kept %.1f s "
                 "after space was freed (includes the visitor posing again)\n",
                 kept - freed);

@@ -21,7 +21,7 @@ fs::path writeFile(const fs::path& path, const std::string& text) {
     return path;
 }
 
-std::string errorOf(const fs::path& csv, const ManifestColumns& columns) {
+std::string manifestErrorOf(const fs::path& csv, const ManifestColumns& columns) {
     try {
         readCsvManifest(csv, columns);
     } catch (const BoothError& e) {
@@ -62,18 +62,18 @@ TEST(BatchManifest, MissingColumnIsAnErrorNamingTheColumnAndTheFile) {
     const fs::path dir = test::scratchDir("unit_batch_manifest_columns");
     const fs::path csv = writeFile(dir / "pairs.csv", "person_id,front,profile\n001,a.jpg,b.jpg\n");
     ManifestColumns c;  // defaults: front, side
-    const std::string e = errorOf(csv, c);
+    const std::string e = manifestErrorOf(csv, c);
     EXPECT_NE(e.find("'side'"), std::string::npos) << e;
     EXPECT_NE(e.find("--side-column"), std::string::npos) << e;
     EXPECT_NE(e.find(csv.string()), std::string::npos) << e;
     EXPECT_NE(e.find("person_id, front, profile"), std::string::npos) << e;  // the columns there are
     c.side = {"profile"};
     c.front = "frontal";
-    const std::string f = errorOf(csv, c);
+    const std::string f = manifestErrorOf(csv, c);
     EXPECT_NE(f.find("'frontal'"), std::string::npos) << f;
     c.front = "front";
     c.id = "who";
-    EXPECT_NE(errorOf(csv, c).find("'who'"), std::string::npos);
+    EXPECT_NE(manifestErrorOf(csv, c).find("'who'"), std::string::npos);
 }
 
 TEST(BatchManifest, QuotesCrlfBomAndBrokenRows) {
@@ -105,9 +105,9 @@ TEST(BatchManifest, QuotesCrlfBomAndBrokenRows) {
 
 TEST(BatchManifest, FileLevelErrors) {
     const fs::path dir = test::scratchDir("unit_batch_manifest_files");
-    EXPECT_NE(errorOf(dir / "none.csv", {}).find("not found"), std::string::npos);
-    EXPECT_NE(errorOf(writeFile(dir / "empty.csv", ""), {}).find("empty"), std::string::npos);
-    EXPECT_NE(errorOf(writeFile(dir / "open.csv", "id,front,side\n1,\"a.jpg,b.jpg\n"), {}).find("open.csv:2"),
+    EXPECT_NE(manifestErrorOf(dir / "none.csv", {}).find("not found"), std::string::npos);
+    EXPECT_NE(manifestErrorOf(writeFile(dir / "empty.csv", ""), {}).find("empty"), std::string::npos);
+    EXPECT_NE(manifestErrorOf(writeFile(dir / "open.csv", "id,front,side\n1,\"a.jpg,b.jpg\n"), {}).find("open.csv:2"),
               std::string::npos);
     const fs::path dup = writeFile(dir / "dup.csv", "id,front,side\n1,a,b\n1,c,d\n");
     try {

@@ -9,7 +9,9 @@
 #include <random>
 
 namespace avatarbooth::toon {
-namespace {
+// Named, not anonymous: the helpers share their names with toon_correspondence_test.cpp's, which a unity build
+// of the tests puts in the same translation unit.
+namespace two_view_test {
 
 // A flat-coloured ball of the synthetic character: drawn as a disc with a black outline in every view.
 struct Ball {
@@ -223,5 +225,5 @@ TEST(ToonRender, FrontAndSideRendersReproduceTheDrawingsAndTheOtherSideIsMirrore
     EXPECT_EQ(cv::norm(mirrored, half, cv::NORM_INF), 0.0);
 }
 
-}  // namespace
+}  // namespace two_view_test
 }  // namespace avatarbooth::toon
