@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace avatarbooth {
@@ -93,6 +94,7 @@ struct Analysis {
     cv::Vec3d hairLab{0, 0, 0};
     bool hair = false;
     std::vector<cv::Rect> crown;  // one column strip each
+    std::array<cv::Rect, 2> temples;  // beside the face, from the image's top to the eyes
     std::array<cv::Rect, 2> besideFace, belowChin;
     cv::Rect behindHead, downTheBack;
     std::array<Ellipse, 2> cheeks, jaw;
@@ -237,18 +239,37 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions&
     out.evidence.crown = crownPixels ? static_cast<double>(farPixels) / static_cast<double>(crownPixels) : 0.0;
     if (farPixels >= 20) {
         a.hair = true;
+        const cv::Vec3d crownLab{median(hairLab[0]), median(hairLab[1]), median(hairLab[2])};
+        out.evidence.hairFromSkin = labDistance(cv::Vec3f(crownLab), a.skinLab);
+
+        // --- The hair's colour: the crown's pixels unlike skin and those beside the face from the head's top to the
+        // eyes (the temples, or the hair falling past them). The crown alone is where the light falls hardest:
+        // light blond hair read pale grey there, too far from its own strands lower down to find them
+        // (HairPopulation 22 and 28, long hair read as short).
+        const int eyeY = static_cast<int>(std::min(eyeR.y, eyeL.y));
+        a.temples = {rectOf(faceLeft - 40.0 * mm, 0, faceLeft, eyeY), rectOf(faceRight, 0, faceRight + 40.0 * mm, eyeY)};
+        for (const cv::Rect& r : a.temples) {
+            const cv::Rect t = r & cv::Rect(0, 0, fm.cols, fm.rows);
+            for (int x = t.x; x < t.x + t.width; ++x)
+                for (int y = t.y; y < t.y + t.height; ++y) {
+                    if (!inFront(x, y)) continue;
+                    const cv::Vec3f& l = a.frontLab.at<cv::Vec3f>(y, x);
+                    if (labDistance(l, a.skinLab) <= kSkinRadius) continue;
+                    const cv::Vec3b& b = photos.front.at<cv::Vec3b>(y, x);
+                    for (std::size_t c = 0; c < 3; ++c) hairLab[c].push_back(l[static_cast<int>(c)]), hairBgr[c].push_back(b[static_cast<int>(c)]);
+                }
+        }
         a.hairLab = {median(hairLab[0]), median(hairLab[1]), median(hairLab[2])};
         out.hairLab = a.hairLab;
-        out.evidence.hairFromSkin = labDistance(cv::Vec3f(a.hairLab), a.skinLab);
         out.colour = {median(hairBgr[0]), median(hairBgr[1]), median(hairBgr[2])};
 
-        // --- Hair, or the forehead's skin in the shade (HairOptions::shadeHueShift says why).
+        // --- Hair, or the forehead's skin in the shade (HairOptions::shadeHueShift says why): the crown's colour.
         const auto [forehead, foreheadPixels] =
             channelMedians<float>(a.frontLab, rectOf(midX - 15.0 * mm, browY - 20.0 * mm, midX + 15.0 * mm, browY - 5.0 * mm), inFront);
         HairEvidence& e = out.evidence;
         e.foreheadFromSkin = labDistance(cv::Vec3f(forehead), a.skinLab);
-        e.crownHueShift = std::abs(std::remainder(hueDegrees(a.hairLab) - hueDegrees(forehead), 360.0));
-        e.crownSaturation = saturation(a.hairLab) / std::max(1e-3, saturation(forehead));
+        e.crownHueShift = std::abs(std::remainder(hueDegrees(crownLab) - hueDegrees(forehead), 360.0));
+        e.crownSaturation = saturation(crownLab) / std::max(1e-3, saturation(forehead));
         // Each crown column from 10 mm over the brows (above the brows' hair) to 3 mm under the silhouette's top
         // (whose pixels mix with the backdrop), blurred by 1 mm (single hairs, the camera's noise).
         const int from = static_cast<int>(browY - 10.0 * mm);
@@ -298,10 +319,24 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions&
     const cv::Point2d ear = canon(photos.sidePoints.at("ear_hole"));
     const double heightMm = (p[8].y - p[27].y) / mm;
     const double smm = heightMm > 1.0 ? std::abs(chinS.y - nasion.y) / heightMm : mm;  // side pixels per millimetre
-    // A ponytail hangs well behind the head (MakeHuman's ponytail01 100-150 mm behind the ear hole).
-    a.behindHead = rectOf(ear.x - 160.0 * smm, ear.y + 48.0 * smm, ear.x - 65.0 * smm, ear.y + 70.0 * smm);
-    a.downTheBack = rectOf(ear.x - 170.0 * smm, ear.y + 75.0 * smm, ear.x - 70.0 * smm, ear.y + 100.0 * smm);
-    a.frontHair = hairJoinedToCrown(a.frontLab, photos.frontMask, a.crown, a, mm);
+    // A ponytail hangs from the back of the head, below it: windows under the rearmost point of the head's outline
+    // (hair included: the tied tail's end) 25-70 mm over the ear hole, not at a distance from the ear (heads and hair
+    // volumes differ: HairPopulation's ponytails 12 and 16 hung 160-200 mm behind the ear hole, past windows set
+    // 65-160 mm behind it). Under short hair these windows hold the backdrop, and the nape's skin at their edge.
+    int backX = std::numeric_limits<int>::max();
+    for (int y = std::max(0, static_cast<int>(ear.y - 70.0 * smm)); y <= static_cast<int>(ear.y - 25.0 * smm) && y < a.sideMask.rows; ++y)
+        for (int x = 0; x < static_cast<int>(ear.x) && x < a.sideMask.cols; ++x)
+            if (a.sideMask.at<std::uint8_t>(y, x)) {
+                backX = std::min(backX, x);
+                break;
+            }
+    if (backX == std::numeric_limits<int>::max()) backX = static_cast<int>(ear.x - 100.0 * smm);  // no outline there
+    a.behindHead = rectOf(backX - 25.0 * smm, ear.y + 48.0 * smm, backX + 45.0 * smm, ear.y + 70.0 * smm);
+    a.downTheBack = rectOf(backX - 30.0 * smm, ear.y + 75.0 * smm, backX + 40.0 * smm, ear.y + 100.0 * smm);
+    // The front's hair is what joins the crown or the temples (where the hair's colour was read).
+    std::vector<cv::Rect> frontSeeds = a.crown;
+    frontSeeds.insert(frontSeeds.end(), a.temples.begin(), a.temples.end());
+    a.frontHair = hairJoinedToCrown(a.frontLab, photos.frontMask, frontSeeds, a, mm);
     a.sideHair = hairJoinedToCrown(a.sideLab, a.sideMask, sideCrown(a.sideMask, ear, smm), a, smm);
 
     // --- Beard windows: the chin between the lower lip and the chin's edge, the upper lip, the jaw beside the mouth.

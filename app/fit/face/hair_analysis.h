@@ -50,8 +50,8 @@ struct HairEvidence {
     double hairline = 0.0;
     double besideFace = 0.0;       // front: beside the jaw, from the nose's base to the lower lip
     double belowChin = 0.0;        // front: beside the neck, 10-45 mm under the chin
-    double behindHead = 0.0;       // side: 65-160 mm behind the ear hole, 48-70 mm under it
-    double downTheBack = 0.0;      // side: 70-170 mm behind the ear hole, 75-100 mm under it
+    double behindHead = 0.0;       // side: 45 mm behind to 25 mm before the skull's back, 48-70 mm under the ear hole
+    double downTheBack = 0.0;      // side: 55 mm behind to 20 mm before the skull's back, 75-100 mm under the ear hole
     double chinDarkening = 0.0;    // skin lightness (CIE L*) of the upper cheeks minus the chin's
     double upperLipDarkening = 0.0;  // likewise, the upper lip's
     double jawDarkening = 0.0;     // likewise, the jaw's beside the mouth (the darker side... the lighter of the two)
@@ -59,7 +59,7 @@ struct HairEvidence {
 
 struct HairEstimate {
     HairStyle style = HairStyle::None;
-    cv::Vec3d colour{0.0, 0.0, 0.0};        // BGR 0..255: the median hair pixel (the crown's), when there is hair
+    cv::Vec3d colour{0.0, 0.0, 0.0};        // BGR 0..255: the median hair pixel (crown and temples), when there is hair
     bool beard = false;                     // chin and jaw darker than the cheeks
     bool moustache = false;                 // the upper lip darker than the cheeks
     cv::Vec3d beardColour{0.0, 0.0, 0.0};   // BGR, the chin's (or the upper lip's) median, when either
@@ -88,7 +88,9 @@ struct HairOptions {
     // the long threshold with nothing beside the jaw (0.00-0.04: HairPopulation's people 13 and 17).
     double longBeside = 0.1;
     double beside = 0.2;         // besideFace over this (not long): a bob
-    double ponytail = 0.3;       // downTheBack and behindHead over this (nothing beside the face or neck): a ponytail
+    // downTheBack and behindHead over this (nothing beside the face or neck): a ponytail. Measured (both windows,
+    // the smaller): HairPopulation's ponytails 0.29-1.00, its short hair 0.00-0.01; FRMDB's short hair up to 0.14.
+    double ponytail = 0.2;
     // The crown is the forehead's skin in the shade (no hair) when, with the forehead itself skin, its colour is
     // one shading can give (hue within shadeHueShift degrees of the forehead's, saturation over shadeSaturation of
     // it) and no hairline lies between them (HairEvidence::hairline under hairlineStep). Shading keeps the hue but
