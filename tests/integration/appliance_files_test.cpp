@@ -1,6 +1,7 @@
 // The appliance's system files, checked by the real Debian tools: the service unit (systemd-analyze verify, and its
 // `systemd-analyze security` exposure at most 2.0), tmpfiles.d and sysusers.d applied to a scratch root, the
 // device-tree overlay compiled by dtc without warnings, and its GPIO numbers equal to booth.toml's and the README's.
+#include "run_shell.h"
 #include "test_paths.h"
 
 #include "config/booth_config.h"
@@ -24,21 +25,8 @@ namespace {
 
 const fs::path kSource = AVATARBOOTH_TEST_SOURCE_DIR;
 
-struct CommandResult {
-    int exitCode = -1;
-    std::string output;  // stdout and stderr together
-};
-
-CommandResult shell(const std::string& cmd) {
-    CommandResult r;
-    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-    if (pipe == nullptr) return r;
-    std::array<char, 4096> buf{};
-    while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-    const int status = pclose(pipe);
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
+// stdout and stderr together.
+CommandResult shell(const std::string& cmd) { return runShell(cmd + " 2>&1"); }
 
 // The tools come from Debian packages tests/setup.sh installs; a missing one is a failed test, not a skip.
 void requireTool(const std::string& tool, const std::string& package) {
