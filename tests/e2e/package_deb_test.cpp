@@ -1,7 +1,7 @@
 // The Debian package: built by CPack from this build, inspected with dpkg-deb (control fields, maintainer scripts,
 // the files and where they go), unpacked into a scratch root with dpkg -x, and the installed binary run from there
 // (--version, check), so the installed layout works, not only the build tree.
-#include "run_binary.h"
+#include "run_shell.h"
 #include "test_paths.h"
 
 #include <gtest/gtest.h>

@@ -218,6 +218,14 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions&
     const double faceLeft = p[0].x, faceRight = p[16].x, faceWidth = faceRight - faceLeft;
     std::size_t crownPixels = 0, farPixels = 0;
     std::array<std::vector<double>, 3> hairLab, hairBgr;
+    // Adds the pixel to the hair's colour sample when it is unlike the cheeks' skin; whether it was.
+    const auto sampleUnlikeSkin = [&](int x, int y) {
+        const cv::Vec3f& l = a.frontLab.at<cv::Vec3f>(y, x);
+        if (labDistance(l, a.skinLab) <= kSkinRadius) return false;
+        const cv::Vec3b& b = photos.front.at<cv::Vec3b>(y, x);
+        for (std::size_t c = 0; c < 3; ++c) hairLab[c].push_back(l[static_cast<int>(c)]), hairBgr[c].push_back(b[static_cast<int>(c)]);
+        return true;
+    };
     for (int x = static_cast<int>(faceLeft + 0.15 * faceWidth); x <= static_cast<int>(faceRight - 0.15 * faceWidth); ++x) {
         if (x < 0 || x >= fm.cols) continue;
         int top = -1;
@@ -229,11 +237,7 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions&
         for (int y = top + 1; y <= bottom; ++y) {
             if (!inFront(x, y)) continue;
             ++crownPixels;
-            const cv::Vec3f& l = a.frontLab.at<cv::Vec3f>(y, x);
-            if (labDistance(l, a.skinLab) <= kSkinRadius) continue;
-            ++farPixels;
-            const cv::Vec3b& b = photos.front.at<cv::Vec3b>(y, x);
-            for (std::size_t c = 0; c < 3; ++c) hairLab[c].push_back(l[static_cast<int>(c)]), hairBgr[c].push_back(b[static_cast<int>(c)]);
+            if (sampleUnlikeSkin(x, y)) ++farPixels;
         }
     }
     out.evidence.crown = crownPixels ? static_cast<double>(farPixels) / static_cast<double>(crownPixels) : 0.0;
@@ -251,13 +255,8 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions&
         for (const cv::Rect& r : a.temples) {
             const cv::Rect t = r & cv::Rect(0, 0, fm.cols, fm.rows);
             for (int x = t.x; x < t.x + t.width; ++x)
-                for (int y = t.y; y < t.y + t.height; ++y) {
-                    if (!inFront(x, y)) continue;
-                    const cv::Vec3f& l = a.frontLab.at<cv::Vec3f>(y, x);
-                    if (labDistance(l, a.skinLab) <= kSkinRadius) continue;
-                    const cv::Vec3b& b = photos.front.at<cv::Vec3b>(y, x);
-                    for (std::size_t c = 0; c < 3; ++c) hairLab[c].push_back(l[static_cast<int>(c)]), hairBgr[c].push_back(b[static_cast<int>(c)]);
-                }
+                for (int y = t.y; y < t.y + t.height; ++y)
+                    if (inFront(x, y)) sampleUnlikeSkin(x, y);
         }
         a.hairLab = {median(hairLab[0]), median(hairLab[1]), median(hairLab[2])};
         out.hairLab = a.hairLab;

@@ -50,8 +50,10 @@ struct HairEvidence {
     double hairline = 0.0;
     double besideFace = 0.0;       // front: beside the jaw, from the nose's base to the lower lip
     double belowChin = 0.0;        // front: beside the neck, 10-45 mm under the chin
-    double behindHead = 0.0;       // side: 45 mm behind to 25 mm before the skull's back, 48-70 mm under the ear hole
-    double downTheBack = 0.0;      // side: 55 mm behind to 20 mm before the skull's back, 75-100 mm under the ear hole
+    // side: 48-70 mm under the ear hole, from 25 mm behind to 45 mm before the head's rearmost point (its outline,
+    // hair included, 25-70 mm over the ear hole)
+    double behindHead = 0.0;
+    double downTheBack = 0.0;      // side: 75-100 mm under the ear hole, from 30 mm behind to 40 mm before that point
     double chinDarkening = 0.0;    // skin lightness (CIE L*) of the upper cheeks minus the chin's
     double upperLipDarkening = 0.0;  // likewise, the upper lip's
     double jawDarkening = 0.0;     // likewise, the jaw's beside the mouth (the darker side... the lighter of the two)
