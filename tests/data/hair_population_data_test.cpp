@@ -46,6 +46,7 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
     std::map<std::string, std::map<std::string, int>> confusion;  // truth -> estimate -> count
     int styleRight = 0, beardRight = 0, moustacheRight = 0, withHair = 0, refused = 0, bald = 0, baldRight = 0;
     int longHair = 0, longRight = 0;
+    int tipsNear = 0, nasionsNear = 0;
     std::vector<double> colourErrors;
     const fs::path out = test::scratchDir("hair_population");
     for (unsigned seed = 1; seed <= kPeople; ++seed) {
@@ -66,6 +67,12 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
         photos.sideMask = side.mask;
         photos.sideNoseImageRight = side.noseImageRight;
         for (const auto& q : side.landmarks) photos.sidePoints[q.name] = q.px;
+        // Where the profile analysis put the nose tip and the nasion, against the truth (pixels, 0.6 mm each).
+        const double tipPx = cv::norm(photos.sidePoints.at("nose_tip") - v.photos.sideLandmarks.at("nose_tip"));
+        const double nasionPx = cv::norm(photos.sidePoints.at("nasion") - v.photos.sideLandmarks.at("nasion"));
+        tipsNear += tipPx <= 6.0;
+        nasionsNear += nasionPx <= 10.0;
+        std::printf("%3u profile: nose tip %.1f px from the true one, nasion %.1f px\n", seed, tipPx, nasionPx);
         } catch (const BoothError& err) {
             // The booth refuses such photos; the hair analysis never sees them.
             ++refused;
@@ -117,15 +124,25 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
                 "people with hair\n",
                 styleRight, kPeople, beardRight, moustacheRight, kPeople, medianDe, colourErrors.empty() ? 0.0 : colourErrors.back(),
                 withHair);
-    // With MakeHuman's hair proxies in the photos, a quarter of the side photos are refused by the profile analysis
-    // (a fringe or a bob over the profile: issue 22's profile work); the rest is what held when this was written.
+    // With MakeHuman's hair proxies in the photos: a fringe or a quiff standing as far forward as the nose was taken
+    // for it, and 5 clean profiles were refused (3, 7, 27, 33, 35: "nasion 0.45 V above the nose tip", "no nose-like
+    // forward bulge"); the profile analysis now tries the next bulge (fitProfile). Still refused: the three bobs
+    // whose hair hides the profile (9, 20, 34). The profile's points are where the truth has them: every nose tip
+    // within 6 px (3.6 mm) but one (36, whose full lips stand 2 px further forward than her nose), every nasion within
+    // 10 px but one (29, whose bob's fringe covers the forehead down to the brows: the nasion is taken under it),
+    // as before the fringes were told from noses. The rest is what held when this was written.
     const int analysed = static_cast<int>(kPeople) - refused;
-    EXPECT_LE(refused, 12);
+    std::printf("profile: of %d, %d nose tips within 6 px of the truth, %d nasions within 10 px\n", analysed, tipsNear,
+                nasionsNear);
+    EXPECT_LE(refused, 3);
+    EXPECT_GE(tipsNear, analysed - 1);
+    EXPECT_GE(nasionsNear, analysed - 1);
     // A bald crown's shading is no hair (HairOptions::shadeHueShift): all 5 bald or balding people analysed. Long
     // hair reads long whatever its colour: the hair's colour is read from the temples too, not from the crown's top
     // light alone (blond 22 and 28 read short before). 27 of the 28 analysed styles right when this was written
-    // (the bob of 29 reads long: it reaches past the chin as far as FRMDB's long hair does); 20 before the
-    // forehead's comparison and the hairline, 24 before the temples and the ponytail windows under the head's back.
+    // (the bob of 29 reads long: it reaches past the chin as far as FRMDB's long hair does), 32 of 33 with the
+    // profiles under a fringe; 20 before the forehead's comparison and the hairline, 24 before the temples and the
+    // ponytail windows under the head's back.
     EXPECT_EQ(baldRight, bald);
     EXPECT_EQ(longRight, longHair);
     EXPECT_GE(styleRight, analysed * 9 / 10);

@@ -240,12 +240,14 @@ struct NoseChoice {
     double prominence = 0.0;
 };
 
-// The nose tip: among the forward bulges of the front chain (local maxima of x), those that stand out by
+// Nose tip candidates: the forward bulges of the front chain (local maxima of x) that stand out by
 // kMinNoseProminence * V on both sides (V = their own height below the top: the candidate's own scale) within
 // 0.4 V above (the nasion is 0.20-0.26 V above the tip) and 0.3 V below (subnasale and lips), on a head at least
-// kMinHeadLengthOverV * V long at half that height; the most forward of those.
-NoseChoice noseCandidate(const Chain& f, double yTop, const WidthProfile& widths, double outlineHeight) {
-    NoseChoice best;
+// kMinHeadLengthOverV * V long at half that height; the most forward first. Hair can make such a bulge too: a
+// fringe or a quiff standing as far forward as the nose (fitProfile tries the next when the face below one is no
+// face).
+std::vector<NoseChoice> noseCandidates(const Chain& f, double yTop, const WidthProfile& widths, double outlineHeight) {
+    std::vector<NoseChoice> out;
     const auto ext = zigzag(f.x, 0, f.size() - 1, kCandidateHysteresis * outlineHeight);
     for (const auto& e : ext) {
         if (!e.isMax) continue;
@@ -258,9 +260,10 @@ NoseChoice noseCandidate(const Chain& f, double yTop, const WidthProfile& widths
         const double prominence = std::min(f.xv(m) - minUp, f.xv(m) - minDown) / V;
         if (prominence < kMinNoseProminence) continue;
         if (widths.at(yTop + 0.5 * V) < kMinHeadLengthOverV * V) continue;
-        if (best.index < 0 || f.xv(m) > f.xv(best.index)) best = {m, prominence};
+        out.push_back({m, prominence});
     }
-    return best;
+    std::stable_sort(out.begin(), out.end(), [&](const NoseChoice& a, const NoseChoice& b) { return f.xv(a.index) > f.xv(b.index); });
+    return out;
 }
 
 ProfileFit fail(std::string why) {
@@ -295,61 +298,10 @@ cv::Point2d estimateEarHole(const cv::Point2d& nasion, const cv::Point2d& chin, 
     return nasion + cv::Point2d(q.x * c + q.y * s, -q.x * s + q.y * c);
 }
 
-ProfileFit fitProfile(const std::vector<cv::Point2d>& outlineIn, bool noseRight) {
-    if (!noseRight) {
-        // Mirror (x -> -x), fit, mirror the answers back.
-        std::vector<cv::Point2d> mirrored(outlineIn);
-        for (auto& p : mirrored) p.x = -p.x;
-        ProfileFit fit = fitProfile(mirrored, true);
-        for (auto& lm : fit.landmarks) lm.px.x = -lm.px.x;
-        return fit;
-    }
-    // --- clean, orient (top -> forward -> down the face), resample, smooth
-    Curve outline;
-    for (const auto& p : outlineIn)
-        if (outline.empty() || cv::norm(p - outline.back()) > 1e-9) outline.push_back(p);
-    while (outline.size() > 1 && cv::norm(outline.front() - outline.back()) <= 1e-9) outline.pop_back();
-    if (outline.size() < 8) return fail("the outline has fewer than 8 points");
-    double yTopRaw = outline[0].y, yBottom = outline[0].y;
-    for (const auto& p : outline) yTopRaw = std::min(yTopRaw, p.y), yBottom = std::max(yBottom, p.y);
-    const double height = yBottom - yTopRaw;
-    if (height <= 0.0) return fail("the outline is flat");
-    if (signedArea(outline) < 0.0) std::reverse(outline.begin(), outline.end());  // y down: top, then +x
+namespace {
 
-    const double step = height / kStepsPerHeight;
-    const Curve raw = resampleClosed(outline, step);
-    if (raw.size() < 50) return fail("the outline is too short");
-    const Curve smooth = smoothClosed(raw, kSmoothSigmaPerHeight * kStepsPerHeight);
-
-    // --- top of head: the highest smoothed point, refined on the unsmoothed outline (smoothing pulls an uneven
-    // apex towards its flatter side): the highest raw point within 3 sigma of it, then the middle of the raw run
-    // within 0.05% of the height of that (a flat top, or a mask's top row).
-    const int n = static_cast<int>(smooth.size());
-    auto wrap = [n](int i) { return static_cast<std::size_t>((i % n + n) % n); };
-    int iTop = 0;
-    for (int i = 0; i < n; ++i)
-        if (smooth[wrap(i)].y < smooth[wrap(iTop)].y) iTop = i;
-    {
-        const int w = static_cast<int>(std::ceil(3.0 * kSmoothSigmaPerHeight * kStepsPerHeight));
-        int best = iTop;
-        for (int d = -w; d <= w; ++d)
-            if (raw[wrap(iTop + d)].y < raw[wrap(best)].y) best = iTop + d;
-        const double tol = raw[wrap(best)].y + 0.0005 * height;
-        int lo = 0, hi = 0;
-        while (lo > -n / 2 && raw[wrap(best + lo - 1)].y <= tol) --lo;
-        while (hi < n / 2 && raw[wrap(best + hi + 1)].y <= tol) ++hi;
-        iTop = static_cast<int>(wrap(best + (lo + hi) / 2));
-    }
-    const double yTop = smooth[static_cast<std::size_t>(iTop)].y;
-    const double yStop = yBottom - 0.5 * step;  // the chains end where they first reach the outline's lowest level
-
-    const Chain f = makeChain(smooth, raw, iTop, +1, yStop);
-    const Chain b = makeChain(smooth, raw, iTop, -1, yStop);
-    const WidthProfile widths(smooth, yTop, yBottom, 2.0 * step);
-
-    // --- nose tip and scale
-    const NoseChoice nose = noseCandidate(f, yTop, widths, height);
-    if (nose.index < 0) return fail("no nose-like forward bulge on the outline");
+// The landmarks of a profile whose nose tip is `nose` (the rest of fitProfile), or why that is no profile.
+ProfileFit fitFromNoseTip(const Chain& f, const Chain& b, const NoseChoice& nose, double yTop) {
     const int iNose = nose.index;
     const double V = f.y(iNose) - yTop;
 
@@ -501,6 +453,85 @@ ProfileFit fitProfile(const std::vector<cv::Point2d>& outlineIn, bool noseRight)
     fit.ok = true;
     return fit;
 }
+
+
+// fitProfile for a face towards +x.
+ProfileFit fitProfileFacingRight(const std::vector<cv::Point2d>& outlineIn) {
+    // --- clean, orient (top -> forward -> down the face), resample, smooth
+    Curve outline;
+    for (const auto& p : outlineIn)
+        if (outline.empty() || cv::norm(p - outline.back()) > 1e-9) outline.push_back(p);
+    while (outline.size() > 1 && cv::norm(outline.front() - outline.back()) <= 1e-9) outline.pop_back();
+    if (outline.size() < 8) return fail("the outline has fewer than 8 points");
+    double yTopRaw = outline[0].y, yBottom = outline[0].y;
+    for (const auto& p : outline) yTopRaw = std::min(yTopRaw, p.y), yBottom = std::max(yBottom, p.y);
+    const double height = yBottom - yTopRaw;
+    if (height <= 0.0) return fail("the outline is flat");
+    if (signedArea(outline) < 0.0) std::reverse(outline.begin(), outline.end());  // y down: top, then +x
+
+    const double step = height / kStepsPerHeight;
+    const Curve raw = resampleClosed(outline, step);
+    if (raw.size() < 50) return fail("the outline is too short");
+    const Curve smooth = smoothClosed(raw, kSmoothSigmaPerHeight * kStepsPerHeight);
+
+    // --- top of head: the highest smoothed point, refined on the unsmoothed outline (smoothing pulls an uneven
+    // apex towards its flatter side): the highest raw point within 3 sigma of it, then the middle of the raw run
+    // within 0.05% of the height of that (a flat top, or a mask's top row).
+    const int n = static_cast<int>(smooth.size());
+    auto wrap = [n](int i) { return static_cast<std::size_t>((i % n + n) % n); };
+    int iTop = 0;
+    for (int i = 0; i < n; ++i)
+        if (smooth[wrap(i)].y < smooth[wrap(iTop)].y) iTop = i;
+    {
+        const int w = static_cast<int>(std::ceil(3.0 * kSmoothSigmaPerHeight * kStepsPerHeight));
+        int best = iTop;
+        for (int d = -w; d <= w; ++d)
+            if (raw[wrap(iTop + d)].y < raw[wrap(best)].y) best = iTop + d;
+        const double tol = raw[wrap(best)].y + 0.0005 * height;
+        int lo = 0, hi = 0;
+        while (lo > -n / 2 && raw[wrap(best + lo - 1)].y <= tol) --lo;
+        while (hi < n / 2 && raw[wrap(best + hi + 1)].y <= tol) ++hi;
+        iTop = static_cast<int>(wrap(best + (lo + hi) / 2));
+    }
+    const double yTop = smooth[static_cast<std::size_t>(iTop)].y;
+    const double yStop = yBottom - 0.5 * step;  // the chains end where they first reach the outline's lowest level
+
+    const Chain f = makeChain(smooth, raw, iTop, +1, yStop);
+    const Chain b = makeChain(smooth, raw, iTop, -1, yStop);
+    const WidthProfile widths(smooth, yTop, yBottom, 2.0 * step);
+
+    // --- nose tip: the most forward candidate whose face below and above makes a plausible profile
+    const std::vector<NoseChoice> noses = noseCandidates(f, yTop, widths, height);
+    if (noses.empty()) return fail("no nose-like forward bulge on the outline");
+    ProfileFit first;
+    for (std::size_t k = 0; k < noses.size(); ++k) {
+        ProfileFit fit = fitFromNoseTip(f, b, noses[k], yTop);
+        if (fit.ok) {
+            if (k > 0)
+                fit.warnings.push_back(cv::format("the most forward bulge (%.2f of the outline's height below its top) "
+                                                  "is no nose (%s): taken for hair",
+                                                  (f.y(noses[0].index) - yTop) / height, first.failure.c_str()));
+            return fit;
+        }
+        if (k == 0) first = std::move(fit);
+    }
+    return first;
+}
+
+}  // namespace
+
+ProfileFit fitProfile(const std::vector<cv::Point2d>& outlineIn, bool noseRight) {
+    if (!noseRight) {
+        // Mirror (x -> -x), fit, mirror the answers back.
+        std::vector<cv::Point2d> mirrored(outlineIn);
+        for (auto& p : mirrored) p.x = -p.x;
+        ProfileFit fit = fitProfile(mirrored, true);
+        for (auto& lm : fit.landmarks) lm.px.x = -lm.px.x;
+        return fit;
+    }
+    return fitProfileFacingRight(outlineIn);
+}
+
 
 std::vector<ProfilePoint> findProfileLandmarks(const std::vector<cv::Point2d>& outline, bool noseRight,
                                                std::vector<std::string>* warnings) {
