@@ -74,10 +74,10 @@ TEST(HairAnalysisFrmdb, StyleAndBeardAsJudgedByEye) {
         for (const char* side : {"Img_13.jpg", "Img_53.jpg"}) {
             const Result r = analysePair(j.person, side);
             const HairEvidence& e = r.estimate.evidence;
-            std::printf("%03d %s: %-8s (judged %-8s) crown %.2f (%4.1f; forehead %4.1f hue %4.1f sat %.2f hairline %.2f) beside %.2f below %.2f behind %.2f back %.2f | chin %.1f lip %.1f "
+            std::printf("%03d %s: %-8s (judged %-8s) crown %.2f (%4.1f; forehead %4.1f hue %4.1f sat %.2f hairline %.2f) beside %.2f below %.2f clothes %.2f behind %.2f back %.2f | chin %.1f lip %.1f "
                         "jaw %.1f%s%s | colour BGR %.0f %.0f %.0f\n",
                         j.person, side, toString(r.estimate.style), toString(r.expected), e.crown, e.hairFromSkin, e.foreheadFromSkin, e.crownHueShift,
-                        e.crownSaturation, e.hairline, e.besideFace, e.belowChin,
+                        e.crownSaturation, e.hairline, e.besideFace, e.belowChin, e.clothesAsHair,
                         e.behindHead, e.downTheBack, e.chinDarkening, e.upperLipDarkening, e.jawDarkening,
                         r.estimate.beard ? " beard" : "", r.estimate.moustache ? " moustache" : "", r.estimate.colour[0],
                         r.estimate.colour[1], r.estimate.colour[2]);

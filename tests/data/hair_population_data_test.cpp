@@ -99,11 +99,11 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
             colourErrors.push_back(dE);
         }
         const HairEvidence& x = e.evidence;
-        std::printf("%3u %-6s %-9s %-20s -> %-8s | crown %.2f (%4.1f; forehead %4.1f hue %4.1f sat %.2f hairline %.2f) beside %.2f below %.2f behind %.2f back %.2f | beard %-9s chin %5.1f "
+        std::printf("%3u %-6s %-9s %-20s -> %-8s | crown %.2f (%4.1f; forehead %4.1f hue %4.1f sat %.2f hairline %.2f) beside %.2f below %.2f clothes %.2f behind %.2f back %.2f | beard %-9s chin %5.1f "
                     "lip %5.1f jaw %5.1f -> %s%s | dE %.1f\n",
                     seed, p.sex.c_str(), p.hairStyle.c_str(), p.hair.c_str(), toString(e.style), x.crown, x.hairFromSkin, x.foreheadFromSkin, x.crownHueShift,
                     x.crownSaturation, x.hairline, x.besideFace,
-                    x.belowChin, x.behindHead, x.downTheBack, p.beard.c_str(), x.chinDarkening, x.upperLipDarkening,
+                    x.belowChin, x.clothesAsHair, x.behindHead, x.downTheBack, p.beard.c_str(), x.chinDarkening, x.upperLipDarkening,
                     x.jawDarkening, e.beard ? "beard" : "-", e.moustache ? "+moustache" : "", dE);
     }
     std::printf("\nconfusion (rows: truth, columns: estimate)\n%-9s", "");
@@ -139,13 +139,13 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
     EXPECT_GE(nasionsNear, analysed - 1);
     // A bald crown's shading is no hair (HairOptions::shadeHueShift): all 5 bald or balding people analysed. Long
     // hair reads long whatever its colour: the hair's colour is read from the temples too, not from the crown's top
-    // light alone (blond 22 and 28 read short before). 27 of the 28 analysed styles right when this was written
-    // (the bob of 29 reads long: it reaches past the chin as far as FRMDB's long hair does), 32 of 33 with the
-    // profiles under a fringe; 20 before the forehead's comparison and the hairline, 24 before the temples and the
-    // ponytail windows under the head's back.
+    // light alone (blond 22 and 28 read short before). Every one of the 33 analysed styles right when this was
+    // written; 20 of 28 before the forehead's comparison and the hairline, 24 before the temples and the ponytail
+    // windows under the head's back, 27 before clothes of the hair's colour were told from long hair (bob 29 over a
+    // brown shirt read long: HairOptions::clothesAsHair), 32 of 33 with the profiles under a fringe.
     EXPECT_EQ(baldRight, bald);
     EXPECT_EQ(longRight, longHair);
-    EXPECT_GE(styleRight, analysed * 9 / 10);
+    EXPECT_GE(styleRight, analysed - 1);
     EXPECT_GE(beardRight, analysed * 9 / 10);
     EXPECT_GE(moustacheRight, analysed * 9 / 10);
     EXPECT_GE(withHair, 18);

@@ -96,6 +96,7 @@ struct Analysis {
     std::vector<cv::Rect> crown;  // one column strip each
     std::array<cv::Rect, 2> temples;  // beside the face, from the image's top to the eyes
     std::array<cv::Rect, 2> besideFace, belowChin;
+    cv::Rect chest;  // front: the clothes under the neck, 70-100 mm under the chin, 40 mm either side of the middle
     cv::Rect behindHead, downTheBack;
     std::array<Ellipse, 2> cheeks, jaw;
     Ellipse chin, upperLip;
@@ -301,6 +302,7 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions&
     const double chinY = p[8].y;
     a.belowChin = {rectOf(midX - 100.0 * mm, chinY + 10.0 * mm, midX - 55.0 * mm, chinY + 45.0 * mm),
                    rectOf(midX + 55.0 * mm, chinY + 10.0 * mm, midX + 100.0 * mm, chinY + 45.0 * mm)};
+    a.chest = rectOf(midX - 40.0 * mm, chinY + 70.0 * mm, midX + 40.0 * mm, chinY + 100.0 * mm);
 
     // --- Side: canonical (nose right), scaled by the nasion-to-chin height against the front's.
     const bool mirror = !photos.sideNoseImageRight;
@@ -361,14 +363,32 @@ HairEstimate estimateHair(const HairPhotos& photos, const HairOptions& options) 
     e.belowChin = 0.5 * (share(a.frontHair, a.belowChin[0]) + share(a.frontHair, a.belowChin[1]));
     e.behindHead = share(a.sideHair, a.behindHead);
     e.downTheBack = share(a.sideHair, a.downTheBack);
+    // The clothes under the neck (when the photo shows them: half the chest window on the person): the share of
+    // their pixels of the hair's colour. Of the hair's own colour, they fill the windows beside the neck as hair
+    // would (HairPopulation 29's brown bob over a brown shirt read long).
+    if (a.hair) {
+        const cv::Rect chest = a.chest & cv::Rect(0, 0, photos.frontMask.cols, photos.frontMask.rows);
+        int onPerson = 0, hairColoured = 0;
+        for (int y = chest.y; y < chest.y + chest.height; ++y)
+            for (int x = chest.x; x < chest.x + chest.width; ++x)
+                if (photos.frontMask.at<std::uint8_t>(y, x)) {
+                    ++onPerson;
+                    hairColoured += a.isHair(a.frontLab.at<cv::Vec3f>(y, x));
+                }
+        if (2 * onPerson >= std::max(1, a.chest.area())) e.clothesAsHair = static_cast<double>(hairColoured) / onPerson;
+    }
+    const bool clothesLikeHair = e.clothesAsHair > options.clothesAsHair;
 
-    // Long hair shows beside the neck in the front photo; a ponytail only down the back in the side photo, with
+    // Long hair shows beside the neck in the front photo (unless the clothes there are of its colour: then the side
+    // photo's hair down the back says it); a ponytail only down the back in the side photo, with
     // nothing beside the face, hanging from the back of the head down (a dark shirt under short hair fills the lower
     // window alone); a bob beside the face down to the jaw. The side's windows sit where hoods and collars
     // often are, so the front decides where it can.
     // Few crown pixels unlike skin is no hair, unless a hairline shows: hair of the skin's own colour.
     if (!a.hair || (e.crown < options.bald && e.hairline <= options.hairlineStep)) out.style = HairStyle::None;
-    else if (e.belowChin > options.long_ && e.besideFace > options.longBeside) out.style = HairStyle::Long;
+    else if (e.belowChin > options.long_ && e.besideFace > options.longBeside &&
+             (!clothesLikeHair || e.downTheBack > options.longDownTheBack))
+        out.style = HairStyle::Long;
     else if (e.besideFace > options.beside) out.style = HairStyle::Bob;
     else if (e.downTheBack > options.ponytail && e.behindHead > options.ponytail) out.style = HairStyle::Ponytail;
     else out.style = HairStyle::Short;

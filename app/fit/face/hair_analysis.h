@@ -50,6 +50,9 @@ struct HairEvidence {
     double hairline = 0.0;
     double besideFace = 0.0;       // front: beside the jaw, from the nose's base to the lower lip
     double belowChin = 0.0;        // front: beside the neck, 10-45 mm under the chin
+    // front: the share of the clothes' pixels (70-100 mm under the chin, 40 mm either side of the middle) of the
+    // hair's colour; -1 when the photo does not show them
+    double clothesAsHair = -1.0;
     // side: 48-70 mm under the ear hole, from 25 mm behind to 45 mm before the head's rearmost point (its outline,
     // hair included, 25-70 mm over the ear hole)
     double behindHead = 0.0;
@@ -89,6 +92,11 @@ struct HairOptions {
     // there); under a bald crown, whose shading reads as hair of the skin's colour, skin beside the neck reached
     // the long threshold with nothing beside the jaw (0.00-0.04: HairPopulation's people 13 and 17).
     double longBeside = 0.1;
+    // With clothes of the hair's own colour under the neck (clothesAsHair over clothesAsHair: they fill the windows
+    // beside the neck as hair would), long hair also needs downTheBack over longDownTheBack. HairPopulation's long
+    // hair 0.69-0.86 there, its bob 29 (a brown bob over a brown shirt, which read long) 0.15.
+    double clothesAsHair = 0.5;
+    double longDownTheBack = 0.2;
     double beside = 0.2;         // besideFace over this (not long): a bob
     // downTheBack and behindHead over this (nothing beside the face or neck): a ponytail. Measured (both windows,
     // the smaller): HairPopulation's ponytails 0.29-1.00, its short hair 0.00-0.01; FRMDB's short hair up to 0.14.
