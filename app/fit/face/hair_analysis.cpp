@@ -375,7 +375,8 @@ HairEstimate estimateHair(const HairPhotos& photos, const HairOptions& options) 
                     ++onPerson;
                     hairColoured += a.isHair(a.frontLab.at<cv::Vec3f>(y, x));
                 }
-        if (2 * onPerson >= std::max(1, a.chest.area())) e.clothesAsHair = static_cast<double>(hairColoured) / onPerson;
+        if (2 * onPerson >= std::max(1, a.chest.area()))
+            e.clothesAsHair = static_cast<double>(hairColoured) / onPerson;
     }
     const bool clothesLikeHair = e.clothesAsHair > options.clothesAsHair;
 

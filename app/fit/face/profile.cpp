@@ -262,7 +262,8 @@ std::vector<NoseChoice> noseCandidates(const Chain& f, double yTop, const WidthP
         if (widths.at(yTop + 0.5 * V) < kMinHeadLengthOverV * V) continue;
         out.push_back({m, prominence});
     }
-    std::stable_sort(out.begin(), out.end(), [&](const NoseChoice& a, const NoseChoice& b) { return f.xv(a.index) > f.xv(b.index); });
+    std::stable_sort(out.begin(), out.end(),
+                     [&](const NoseChoice& a, const NoseChoice& b) { return f.xv(a.index) > f.xv(b.index); });
     return out;
 }
 
@@ -453,7 +454,6 @@ ProfileFit fitFromNoseTip(const Chain& f, const Chain& b, const NoseChoice& nose
     fit.ok = true;
     return fit;
 }
-
 
 // fitProfile for a face towards +x.
 ProfileFit fitProfileFacingRight(const std::vector<cv::Point2d>& outlineIn) {
