@@ -45,7 +45,7 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
     MeshRenderer renderer;
     std::map<std::string, std::map<std::string, int>> confusion;  // truth -> estimate -> count
     int styleRight = 0, beardRight = 0, moustacheRight = 0, withHair = 0, refused = 0, bald = 0, baldRight = 0;
-    int longHair = 0, longRight = 0;
+    int longHair = 0, longRight = 0, longWrongly = 0;
     int tipsNear = 0, nasionsNear = 0;
     std::vector<double> colourErrors;
     const fs::path out = test::scratchDir("hair_population");
@@ -89,6 +89,7 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
         styleRight += p.hairStyle == toString(e.style);
         if (p.hairStyle == "none") ++bald, baldRight += e.style == HairStyle::None;
         if (p.hairStyle == "long") ++longHair, longRight += e.style == HairStyle::Long;
+        else longWrongly += e.style == HairStyle::Long;
         const bool beard = p.beard == "full", moustache = p.beard != "none";
         beardRight += e.beard == beard;
         moustacheRight += e.moustache == moustache;
@@ -145,6 +146,7 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
     // brown shirt read long: HairOptions::clothesAsHair), 32 of 33 with the profiles under a fringe.
     EXPECT_EQ(baldRight, bald);
     EXPECT_EQ(longRight, longHair);
+    EXPECT_EQ(longWrongly, 0) << "hair read long that is not (clothes of the hair's colour under the neck)";
     EXPECT_GE(styleRight, analysed - 1);
     EXPECT_GE(beardRight, analysed * 9 / 10);
     EXPECT_GE(moustacheRight, analysed * 9 / 10);
