@@ -28,6 +28,38 @@ SoundSettings recordingInto(const fs::path& wav, int volume = 80) {
 
 bool haveTheme() { return fs::exists(SoundSettings{}.themeDir + "/camera-shutter.oga"); }
 
+// How a real-time recording went: whether the player opened, its underruns, and how late the test's own thread came
+// round to a step of its script at worst.
+struct Recording {
+    bool opened = false;
+    int underruns = 0;
+    double lateMs = 0.0;
+};
+
+// Records (`record`) until a recording is undisturbed, at most three times; the last one. The timing under test
+// holds only when the script's steps come when they should: a step that comes more than the stream is written
+// ahead (kAhead) after its sound was due asks for a sound whose frame is already written, and it starts late. On
+// a loaded machine (CI's parallel tests) the test's thread once came round to "3" 120 ms late, so its beep, and the
+// beeps a second apart after it, sounded 120 ms late; a kiosk's loop held up as long would sound as late.
+template <typename Record>
+Recording recordUndisturbed(Record record) {
+    Recording r;
+    for (int attempt = 1; attempt <= 3; ++attempt) {
+        r = record();
+        if (!r.opened || (r.underruns == 0 && r.lateMs <= 20.0)) break;
+        std::printf("attempt %d disturbed (the machine is busy): a step %.0f ms late, %d underruns\n", attempt, r.lateMs,
+                    r.underruns);
+    }
+    return r;
+}
+
+// Sleeps until `at` seconds after `started`; how late it woke, in milliseconds.
+double sleepUntil(std::chrono::steady_clock::time_point started, double at) {
+    const auto due = started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(at));
+    std::this_thread::sleep_until(due);
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - due).count();
+}
+
 ScreenModel screenOf(ScreenId id, int countdown = 0) {
     ScreenModel m;
     m.id = id;
@@ -79,9 +111,12 @@ TEST(BoothSounds, RecordedWavHasTheBeepsAtTheCountdownsTimes) {
     std::string note;
     std::vector<double> asked;  // seconds after the stream's start
     std::chrono::steady_clock::time_point started;
-    {
+    const Recording recording = recordUndisturbed([&] {
+        Recording r;
+        asked.clear();
         auto sounds = BoothSounds::open(recordingInto(wav), note);
-        ASSERT_TRUE(sounds) << note;
+        if (!sounds) return r;
+        r.opened = true;
         started = sounds->player().started();
         // A countdown of 3 at 0.4 s a number (the flow's is 1 s; shorter keeps the test short), the flash, the
         // reveal: the screens as the kiosk's loop shows them, about every 33 ms.
@@ -91,15 +126,19 @@ TEST(BoothSounds, RecordedWavHasTheBeepsAtTheCountdownsTimes) {
             {1.50, screenOf(ScreenId::CaptureFlash)}, {2.10, screenOf(ScreenId::Processing)},
             {2.20, screenOf(ScreenId::Reveal)}};
         for (const auto& [at, screen] : script) {
-            std::this_thread::sleep_until(started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(at)));
+            r.lateMs = std::max(r.lateMs, sleepUntil(started, at));
             const auto now = std::chrono::steady_clock::now();
             sounds->screen(screen, now);
             if (screen.id != ScreenId::FrontGuide && screen.id != ScreenId::Processing)
                 asked.push_back(std::chrono::duration<double>(now - started).count());
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the chime's start is enough
-        EXPECT_EQ(sounds->player().underruns(), 0);
-    }
+        r.underruns = sounds->player().underruns();
+        return r;
+    });
+    ASSERT_TRUE(recording.opened) << note;
+    ASSERT_LE(recording.lateMs, 20.0) << "the machine was too busy for the script's timing on three recordings";
+    EXPECT_EQ(recording.underruns, 0);
     const Wav w = readWav(wav);
     ASSERT_EQ(w.rate, kSoundRate) << "not a WAV from ALSA's file output: " << wav;
     ASSERT_EQ(w.channels, 2);
@@ -134,12 +173,14 @@ TEST(BoothSounds, RecordedWavHasTheBeepsAtTheCountdownsTimes) {
 TEST(BoothSounds, CountdownBeepsKeepTheirRhythmWhenTheLoopIsLate) {
     const fs::path dir = scratchDir("booth_sounds_late");
     const fs::path wav = dir / "late.wav";
+    if (!haveTheme()) GTEST_SKIP() << "sound-theme-freedesktop is not installed (tests/setup.sh installs it)";
     std::string note;
     std::chrono::steady_clock::time_point started;
-    {
+    const Recording recording = recordUndisturbed([&] {
+        Recording r;
         auto sounds = BoothSounds::open(recordingInto(wav), note);
-        if (!sounds && !haveTheme()) GTEST_SKIP() << "sound-theme-freedesktop is not installed (tests/setup.sh installs it)";
-        ASSERT_TRUE(sounds) << note;
+        if (!sounds) return r;
+        r.opened = true;
         started = sounds->player().started();
         // {when the loop shows it (s), the screen, how long ago its number came up (ms)}: number 2 seen 250 ms
         // late, number 1 40 ms late; then a second countdown left for the guide after its first number.
@@ -154,13 +195,17 @@ TEST(BoothSounds, CountdownBeepsKeepTheirRhythmWhenTheLoopIsLate) {
                                        {3.30, ScreenId::CaptureFlash, 0, 0}, {3.40, ScreenId::SideGuide, 0, 0},
                                        {4.30, ScreenId::Countdown, 3, 0},   {4.80, ScreenId::SideGuide, 0, 0}};
         for (const Step& step : script) {
-            std::this_thread::sleep_until(started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(step.at)));
+            r.lateMs = std::max(r.lateMs, sleepUntil(started, step.at));
             ScreenModel screen = screenOf(step.id, step.number);
             screen.countdownAge = Millis(step.ageMs);
             sounds->screen(screen, std::chrono::steady_clock::now());
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(1300));  // past where the abandoned "2" would sound
-    }
+        r.underruns = sounds->player().underruns();
+        return r;
+    });
+    ASSERT_TRUE(recording.opened) << note;
+    ASSERT_LE(recording.lateMs, 20.0) << "the machine was too busy for the script's timing on three recordings";
     const Wav w = readWav(wav);
     ASSERT_EQ(w.rate, kSoundRate);
     const std::vector<double> heard = onsets(w);
