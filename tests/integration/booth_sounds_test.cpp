@@ -47,15 +47,16 @@ Recording recordUndisturbed(Record record) {
     for (int attempt = 1; attempt <= 3; ++attempt) {
         r = record();
         if (!r.opened || (r.underruns == 0 && r.lateMs <= 20.0)) break;
-        std::printf("attempt %d disturbed (the machine is busy): a step %.0f ms late, %d underruns\n", attempt, r.lateMs,
-                    r.underruns);
+        std::printf("attempt %d disturbed (the machine is busy): a step %.0f ms late, %d underruns\n", attempt,
+                    r.lateMs, r.underruns);
     }
     return r;
 }
 
 // Sleeps until `at` seconds after `started`; how late it woke, in milliseconds.
 double sleepUntil(std::chrono::steady_clock::time_point started, double at) {
-    const auto due = started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(at));
+    const auto due =
+        started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(at));
     std::this_thread::sleep_until(due);
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - due).count();
 }
