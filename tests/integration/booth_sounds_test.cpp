@@ -36,19 +36,19 @@ struct Recording {
     double lateMs = 0.0;
 };
 
-// Records (`record`) until a recording is undisturbed, at most three times; the last one. The timing under test
+// Records (`record`) until the script kept its time, at most three times; the last recording. The timing under test
 // holds only when the script's steps come when they should: a step that comes more than the stream is written
 // ahead (kAhead) after its sound was due asks for a sound whose frame is already written, and it starts late. On
 // a loaded machine (CI's parallel tests) the test's thread once came round to "3" 120 ms late, so its beep, and the
 // beeps a second apart after it, sounded 120 ms late; a kiosk's loop held up as long would sound as late.
 template <typename Record>
-Recording recordUndisturbed(Record record) {
+Recording recordUntilOnTime(Record record) {
     Recording r;
     for (int attempt = 1; attempt <= 3; ++attempt) {
         r = record();
-        if (!r.opened || (r.underruns == 0 && r.lateMs <= 20.0)) break;
-        std::printf("attempt %d disturbed (the machine is busy): a step %.0f ms late, %d underruns\n", attempt,
-                    r.lateMs, r.underruns);
+        if (!r.opened || r.lateMs <= 20.0) break;
+        std::printf("attempt %d disturbed (the machine is busy): a step of the script %.0f ms late\n", attempt,
+                    r.lateMs);
     }
     return r;
 }
@@ -112,7 +112,7 @@ TEST(BoothSounds, RecordedWavHasTheBeepsAtTheCountdownsTimes) {
     std::string note;
     std::vector<double> asked;  // seconds after the stream's start
     std::chrono::steady_clock::time_point started;
-    const Recording recording = recordUndisturbed([&] {
+    const Recording recording = recordUntilOnTime([&] {
         Recording r;
         asked.clear();
         auto sounds = BoothSounds::open(recordingInto(wav), note);
@@ -177,7 +177,7 @@ TEST(BoothSounds, CountdownBeepsKeepTheirRhythmWhenTheLoopIsLate) {
     if (!haveTheme()) GTEST_SKIP() << "sound-theme-freedesktop is not installed (tests/setup.sh installs it)";
     std::string note;
     std::chrono::steady_clock::time_point started;
-    const Recording recording = recordUndisturbed([&] {
+    const Recording recording = recordUntilOnTime([&] {
         Recording r;
         auto sounds = BoothSounds::open(recordingInto(wav), note);
         if (!sounds) return r;
@@ -202,7 +202,6 @@ TEST(BoothSounds, CountdownBeepsKeepTheirRhythmWhenTheLoopIsLate) {
             sounds->screen(screen, std::chrono::steady_clock::now());
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(1300));  // past where the abandoned "2" would sound
-        r.underruns = sounds->player().underruns();
         return r;
     });
     ASSERT_TRUE(recording.opened) << note;
