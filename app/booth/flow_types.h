@@ -39,6 +39,7 @@ enum class Hint {
     TurnRight,     // side: a frontal face (or nobody) is seen
     TurnMore,      // side: turned, but not far enough for a profile
     TurnBack,      // side: turned past the profile (the back of the head shows more than the face)
+    FaceHidden,    // side: no face shows (turned well past the profile, or hair hides it): turn a little back
     HoldStill,     // ready (front or side)
 };
 
@@ -48,6 +49,7 @@ enum class FitFailure {
     NotProfile,   // the side photo is not a profile (a front view)
     TurnMore,     // the side photo is turned, but not far enough for a profile
     TurnBack,     // the side photo is turned past the profile
+    FaceHidden,   // no face shows on the side photo (turned well past the profile, or hair hides it)
     Mismatch,     // the two photos do not belong together
     Other,        // anything else (internal error, disk full, ...)
 };

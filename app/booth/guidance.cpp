@@ -44,7 +44,7 @@ Hint frontHint(const FrontObservation& obs, const GuidanceSettings& s) {
 Hint sideHint(const SideObservation& obs) {
     if (!obs.personSeen) return Hint::TurnRight;
     if (obs.frontalFace) return std::abs(obs.frontalYaw) > kHalfTurnedYaw ? Hint::TurnMore : Hint::TurnRight;
-    if (!obs.profileSeen) return Hint::TurnMore;
+    if (!obs.profileSeen) return obs.faceLooked && !obs.faceShows ? Hint::FaceHidden : Hint::TurnMore;
     if (obs.turnedBack) return Hint::TurnBack;
     return Hint::HoldStill;
 }
@@ -146,6 +146,14 @@ SideObservation PreviewAnalyser::observeSide(const cv::Mat& bgr, const cv::Mat& 
             if (turn.known) obs.turnDegrees = turn.degrees;
             obs.turnedBack = turn.pastProfile;
         }
+    } else if (detector_) {
+        // dlib's detector costs about 4x the cascade, so it runs only here, where the outline cannot say which way
+        // the visitor should turn (face/profile.h, analyseSidePhoto does the same). On the frame: a face at the
+        // preview's size is below dlib's 80 px.
+        cv::Mat frameMask;
+        cv::resize(mask, frameMask, bgr.size(), 0, 0, cv::INTER_NEAREST);
+        obs.faceLooked = true;
+        obs.faceShows = faceOnPerson(detector_->detectFaces(bgr), frameMask).has_value();
     }
     return obs;
 }

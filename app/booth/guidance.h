@@ -69,12 +69,18 @@ struct SideObservation {
     double frontalYaw = 0.0;     // with frontalFace and a landmark detector: noseOffsetYaw of that face
     double turnDegrees = 0.0;    // with profileSeen: ProfileTurn::degrees (0 when unknown)
     bool turnedBack = false;     // with profileSeen: ProfileTurn::pastProfile
+    // Without a profile and without the cascade's frontal face, with a landmark detector: whether dlib's detector
+    // (whose filters also find faces looking aside) found a face on the person. None: turned well past the
+    // profile, or hair hides the face.
+    bool faceLooked = false;
+    bool faceShows = false;
 };
 
 // The side guide's hint: "turn to your right" while nobody or a frontal face looking at the camera is seen, "turn
-// more" while half-turned (a frontal face turned more than kHalfTurnedYaw, or an outline without a profile), "turn
-// a little back" when the profile is seen turned clearly past it (ProfileTurn::pastProfile: the ear and the eye
-// agree), else "hold still" (either way: the fit takes both).
+// more" while half-turned (a frontal face turned more than kHalfTurnedYaw, or an outline without a profile whose
+// face still shows), "we can't see your face" when the outline has no profile and no face shows (turned well past
+// it, or hair over the face), "turn a little back" when the profile is seen turned clearly past it
+// (ProfileTurn::pastProfile: the ear and the eye agree), else "hold still" (either way: the fit takes both).
 Hint sideHint(const SideObservation& observation);
 
 // Runs the observations on preview frames. Holds the detectors; not thread-safe (one analyser per thread).

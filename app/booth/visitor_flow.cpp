@@ -79,6 +79,7 @@ const char* toString(Hint hint) {
         case Hint::TurnRight: return "turn_right";
         case Hint::TurnMore: return "turn_more";
         case Hint::TurnBack: return "turn_back";
+        case Hint::FaceHidden: return "face_hidden";
         case Hint::HoldStill: return "hold_still";
     }
     return "?";

@@ -18,6 +18,7 @@ enum class FitFault {
     NotProfile,  // the side photo shows a front view
     TurnMore,    // the side photo is turned, but not far enough for a profile
     TurnBack,    // the side photo is turned past the profile (more of the back of the head shows)
+    FaceHidden,  // no face shows on the side photo: turned well past the profile, or hair hides the face
     Mismatch,    // the two photos do not show the same head the same way
     Other,       // anything else (an unreadable file, an internal failure)
 };

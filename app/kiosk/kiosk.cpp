@@ -58,6 +58,7 @@ FitFailed fitFailureFor(const FitError& e, FlowTime t) {
         case FitFault::NotProfile: reason = FitFailure::NotProfile; break;
         case FitFault::TurnMore: reason = FitFailure::TurnMore; break;
         case FitFault::TurnBack: reason = FitFailure::TurnBack; break;
+        case FitFault::FaceHidden: reason = FitFailure::FaceHidden; break;
         case FitFault::Mismatch: reason = FitFailure::Mismatch; break;
         case FitFault::Other: break;
     }

@@ -139,11 +139,11 @@ TEST(ProfileData, EveryFrmdbViewAsASidePhoto) {
                 }
             }
         }
-    // Measured: 3 of the 8 (004, 006, 007); 002's outline has no profile ("not a profile"), 005's face is turned
-    // less than kHalfTurnedYaw by dlib's points in the cascade's box (a front view), and 001, 003 and 008 (about 60,
-    // 40 and 50 degrees; no frontal face found) pass as profiles, as they did before.
+    // Measured 2026-12-04: 5 of the 8: 004, 005, 006 and 007 by the cascade's face and its dlib points, 002 (whose
+    // outline has no nose) by dlib's detector finding its face looking aside (it was "a front view"); 001, 003 and
+    // 008 (about 60, 40 and 50 degrees; no frontal face found) pass as profiles, as they did before.
     std::cout << "[ frmdb ] Img_43 told to turn more: " << turnMore << " of 8\n";
-    EXPECT_GE(turnMore, 3);
+    EXPECT_GE(turnMore, 5);
 }
 
 TEST(ProfileData, FrmdbFrontsAreRefusedAsFrontViews) {

@@ -131,6 +131,13 @@ std::vector<Case> allScreens() {
         m.banner = BannerKind::FitFailed;
         m.fitFailure = FitFailure::TurnBack;
     });
+    add("side_guide_face_hidden", [](ScreenModel& m) {
+        m.id = ScreenId::SideGuide;
+        m.photo = Photo::Side;
+        m.hint = Hint::FaceHidden;
+        m.banner = BannerKind::FitFailed;
+        m.fitFailure = FitFailure::FaceHidden;
+    });
     add("side_countdown", [](ScreenModel& m) {
         m.id = ScreenId::Countdown;
         m.photo = Photo::Side;

@@ -150,3 +150,16 @@ TEST(Guidance, SideHintSaysWhichWayToTurn) {
     o.turnedBack = true;  // the ear and the eye agree
     EXPECT_EQ(sideHint(o), Hint::TurnBack);
 }
+
+TEST(Guidance, SideHintWithoutAProfileFollowsTheFace) {
+    SideObservation o;
+    o.personSeen = true;  // no frontal face, no nose on the outline
+    EXPECT_EQ(sideHint(o), Hint::TurnMore) << "no detector looked: as before";
+    o.faceLooked = true;
+    o.faceShows = true;  // a face looking aside: turned short of the profile
+    EXPECT_EQ(sideHint(o), Hint::TurnMore);
+    o.faceShows = false;  // turned well past the profile, or hair over the face
+    EXPECT_EQ(sideHint(o), Hint::FaceHidden);
+    o.profileSeen = true;  // a profile: the face check does not count
+    EXPECT_EQ(sideHint(o), Hint::HoldStill);
+}

@@ -92,6 +92,7 @@ std::string bannerKey(const ScreenModel& m) {
                 case FitFailure::NotProfile: return "error.fit.not_profile";
                 case FitFailure::TurnMore: return "error.fit.turn_more";
                 case FitFailure::TurnBack: return "error.fit.turn_back";
+                case FitFailure::FaceHidden: return "error.fit.face_hidden";
                 case FitFailure::Mismatch: return "error.fit.mismatch";
                 case FitFailure::Other: return "error.fit.other";
             }

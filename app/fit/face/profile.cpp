@@ -767,6 +767,14 @@ ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, con
     return turn;
 }
 
+std::optional<cv::Rect> faceOnPerson(const std::vector<cv::Rect>& faces, const cv::Mat& personMask) {
+    for (const cv::Rect& f : faces) {
+        const cv::Point c(f.x + f.width / 2, f.y + f.height / 2);
+        if (c.inside(cv::Rect(0, 0, personMask.cols, personMask.rows)) && personMask.at<unsigned char>(c)) return f;
+    }
+    return std::nullopt;
+}
+
 double noseOffsetYaw(const std::array<cv::Point2d, 68>& p) {
     const cv::Point2d eyeL = p[36], eyeR = p[45], nose = p[30];
     const double eyes = cv::norm(eyeR - eyeL);
@@ -807,10 +815,28 @@ SideAnalysis analyseSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate
                            "this looks like a front view, not a profile (a frontal face was detected)");
         }
     }
-    if (!right.ok && !left.ok)
-        throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::NotProfile, "",
-                       "this looks like a front view, not a profile (no nose stands out from either side of the "
-                       "head's outline: " + right.failure + ")");
+    if (!right.ok && !left.ok) {
+        const std::string noNose = "no nose stands out from either side of the head's outline: " + right.failure;
+        if (!options.landmarkDetector)
+            throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::NotProfile, "",
+                           "this looks like a front view, not a profile (" + noNose + ")");
+        // Which way to turn: the outline cannot say (see ProfileTurn), the face can. dlib's HOG detector, with its
+        // filters for faces looking aside, finds the face of every synthetic visitor turned 55-66 degrees and of
+        // none turned 114-150 (README, issue 22); a bob hiding the face shows none either.
+        const auto face = faceOnPerson(options.landmarkDetector->detectFaces(bgr), out.mask);
+        if (!face)
+            throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::FaceHidden, "",
+                           "no face shows in the side photo (" + noNose + "; no face found on the head): turned past "
+                           "the profile, or hair hides the face: turn a little back towards the camera, hair behind "
+                           "the ear");
+        const double yaw = noseOffsetYaw(options.landmarkDetector->landmarksIn(bgr, *face));
+        if (std::abs(yaw) <= kHalfTurnedYaw)
+            throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::NotProfile, "",
+                           "this looks like a front view, not a profile (" + noNose + "; a face looks at the camera)");
+        throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::TurnMore, "",
+                       "the side photo is turned short of the profile (" + noNose + "; a face turned aside shows): "
+                       "turn more");
+    }
 
     const bool useRight = right.ok && (!left.ok || right.noseProminence >= left.noseProminence);
     const ProfileFit& fit = useRight ? right : left;

@@ -7,6 +7,7 @@
 #include <array>
 #include <filesystem>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -158,6 +159,10 @@ struct SideOptions {
 // A face's turn from the front by its 68 points: the nose tip's offset from the middle of the eyes' outer corners,
 // along the eye line, in eye widths (positive: the nose towards image-right). The front guide's measure.
 double noseOffsetYaw(const std::array<cv::Point2d, 68>& points);
+// The first of `faces` (largest first, as LandmarkDetector::detectFaces gives them) whose box's centre lies on the
+// person (personMask: CV_8U, non-zero on the person); a face on a poster behind the visitor does not count.
+std::optional<cv::Rect> faceOnPerson(const std::vector<cv::Rect>& faces, const cv::Mat& personMask);
+
 // Beyond this |noseOffsetYaw| a face is half-turned (the front guide's maxYaw: frmdb's fronts -0.23 to 0.15, its
 // 45-degree views 0.28-0.38 where the frontal cascade still finds them).
 inline constexpr double kHalfTurnedYaw = 0.26;
@@ -166,8 +171,11 @@ inline constexpr double kHalfTurnedYaw = 0.26;
 // works: the outline is fitted both ways, a nose pointing left is fitted mirrored and the points mapped back),
 // profile landmarks.
 // Throws BoothError: BadInput (empty/odd image), NoFace (nothing stands out from the background),
-// Mismatch "this looks like a front view, not a profile" when a frontal face is detected on the head or neither
-// side of the silhouette has a nose.
+// FitError (Mismatch) when the photo is no profile, its fault saying which way to turn: NotProfile "this looks like
+// a front view" (a frontal face looks at the camera), TurnMore (a face turned aside shows: the cascade's with dlib's
+// points, or, when neither side of the outline has a nose, dlib's detector's), FaceHidden (no nose on the outline
+// and no face: turned well past the profile, or hair over the face; needs options.landmarkDetector, else such a
+// photo is NotProfile), TurnBack (a profile turned past, with options.refusePastProfile).
 SideAnalysis analyseSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate = cv::Mat(),
                               const SideOptions& options = {});
 
