@@ -251,13 +251,32 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions&
         // eyes (the temples, or the hair falling past them). The crown alone is where the light falls hardest:
         // light blond hair read pale grey there, too far from its own strands lower down to find them
         // (HairPopulation 22 and 28, long hair read as short).
+        // The silhouette can reach into a backdrop of little contrast beside the head (frmdb's dark curtains, by
+        // up to 30-40 px): a pixel there nearer the backdrop's colour (the windows' pixels off the silhouette) than
+        // the crown's hair is not sampled.
         const int eyeY = static_cast<int>(std::min(eyeR.y, eyeL.y));
         a.temples = {rectOf(faceLeft - 40.0 * mm, 0, faceLeft, eyeY), rectOf(faceRight, 0, faceRight + 40.0 * mm, eyeY)};
+        std::array<std::vector<double>, 3> off;
+        for (const cv::Rect& r : a.temples) {
+            const cv::Rect t = r & cv::Rect(0, 0, fm.cols, fm.rows);
+            for (int y = t.y; y < t.y + t.height; ++y)
+                for (int x = t.x; x < t.x + t.width; ++x)
+                    if (!inFront(x, y)) {
+                        const cv::Vec3f& l = a.frontLab.at<cv::Vec3f>(y, x);
+                        for (std::size_t c = 0; c < 3; ++c) off[c].push_back(l[static_cast<int>(c)]);
+                    }
+        }
+        const bool backdropSeen = off[0].size() >= 100;
+        const cv::Vec3d backdropLab = backdropSeen ? cv::Vec3d{median(off[0]), median(off[1]), median(off[2])} : cv::Vec3d{};
         for (const cv::Rect& r : a.temples) {
             const cv::Rect t = r & cv::Rect(0, 0, fm.cols, fm.rows);
             for (int x = t.x; x < t.x + t.width; ++x)
-                for (int y = t.y; y < t.y + t.height; ++y)
-                    if (inFront(x, y)) sampleUnlikeSkin(x, y);
+                for (int y = t.y; y < t.y + t.height; ++y) {
+                    if (!inFront(x, y)) continue;
+                    const cv::Vec3f& l = a.frontLab.at<cv::Vec3f>(y, x);
+                    if (backdropSeen && labDistance(l, backdropLab) < labDistance(l, crownLab)) continue;
+                    sampleUnlikeSkin(x, y);
+                }
         }
         a.hairLab = {median(hairLab[0]), median(hairLab[1]), median(hairLab[2])};
         out.hairLab = a.hairLab;
