@@ -391,6 +391,35 @@ TEST(ScreensPixels, EveryCodeShowsAtOneSizeAndTheWidestFits) {
     }
 }
 
+// The side guide's arrow points where the visitor should turn: their right (the mirrored preview's right) while
+// turning, back the other way when turned past the profile or no face shows. The arrowhead is the arrow's wider end.
+TEST(ScreensPixels, SideArrowPointsTheWayToTurn) {
+    ScreenRenderer& r = renderer(Language::English, {1280, 720});
+    ScreenModel m;
+    m.id = ScreenId::SideGuide;
+    m.photo = Photo::Side;
+    ScreenInputs in;
+    in.preview = previewOf(visitor().v.side);
+    const cv::Rect middle = r.layout().middle;
+    const auto headOnRight = [&](Hint hint) {
+        m.hint = hint;
+        const cv::Mat img = r.draw(m, in);
+        cv::Mat accent;
+        cv::inRange(img(middle), kAccent - cv::Scalar::all(40), kAccent + cv::Scalar::all(40), accent);
+        const cv::Rect box = cv::boundingRect(accent);
+        EXPECT_GT(box.width, 40) << toString(hint) << ": no arrow";
+        // Column counts of the arrow's pixels: the head's end has the most.
+        const int third = box.width / 3;
+        const int left = cv::countNonZero(accent(cv::Rect(box.x, box.y, third, box.height)));
+        const int right = cv::countNonZero(accent(cv::Rect(box.br().x - third, box.y, third, box.height)));
+        return right > left;
+    };
+    EXPECT_TRUE(headOnRight(Hint::TurnRight));
+    EXPECT_TRUE(headOnRight(Hint::TurnMore));
+    EXPECT_FALSE(headOnRight(Hint::TurnBack));
+    EXPECT_FALSE(headOnRight(Hint::FaceHidden));
+}
+
 TEST(ScreensPixels, HintTextFollowsTheHint) {
     ScreenRenderer& r = renderer(Language::English, {1280, 720});
     ScreenModel m;

@@ -475,8 +475,9 @@ void ScreenRenderer::guide(const ScreenModel& m, const ScreenInputs& in) {
     const cv::Rect pressBox(hintBox.x, hintBox.br().y, hintBox.width, L.bottom.br().y - hintBox.br().y);
     drawText(str("guide.press_now"), pressBox, static_cast<int>(30 * u), kGrey);
     if (!front && m.hint != Hint::HoldStill && !in.preview.empty()) {
-        // An arrow towards where the visitor turns (their right: the mirrored preview's right), beside the oval
-        // when there is room, else above the hint.
+        // An arrow towards where the visitor turns (their right: the mirrored preview's right; back towards the
+        // camera, the other way, when turned past the profile or the face is hidden), beside the oval when there is
+        // room, else above the hint.
         const cv::Rect2d oval = ovalBox(settings_.oval, in.preview.size());
         const double ovalRight = previewToScreen({oval.x, oval.y + oval.height / 2}, in.preview.size()).x;
         const int gap = static_cast<int>(24 * u), want = static_cast<int>(std::min(canvas_.cols, canvas_.rows) * 0.2);
@@ -489,6 +490,7 @@ void ScreenRenderer::guide(const ScreenModel& m, const ScreenInputs& in) {
             a = cv::Point(canvas_.cols / 2 - want / 2, L.bottom.y - static_cast<int>(60 * u));
             b = a + cv::Point(want, 0);
         }
+        if (hint == Hint::TurnBack || hint == Hint::FaceHidden) std::swap(a, b);
         cv::arrowedLine(canvas_, a, b, kAccent, std::max(3, static_cast<int>(10 * u)), cv::LINE_AA, 0, 0.35);
     }
 }
