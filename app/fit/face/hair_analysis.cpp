@@ -398,19 +398,20 @@ HairEstimate estimateHair(const HairPhotos& photos, const HairOptions& options) 
             e.clothesAsHair = static_cast<double>(hairColoured) / onPerson;
     }
     const bool clothesLikeHair = e.clothesAsHair > options.clothesAsHair;
+    const bool tiedBack = e.downTheBack > options.ponytail && e.behindHead > options.ponytail;
 
     // Long hair shows beside the neck in the front photo (unless the clothes there are of its colour: then the side
     // photo's hair down the back says it); a ponytail only down the back in the side photo, with
     // nothing beside the face, hanging from the back of the head down (a dark shirt under short hair fills the lower
-    // window alone); a bob beside the face down to the jaw. The side's windows sit where hoods and collars
+    // window alone); a bob beside the face down to the jaw (filling it, when the side shows hair tied back). The side's windows sit where hoods and collars
     // often are, so the front decides where it can.
     // Few crown pixels unlike skin is no hair, unless a hairline shows: hair of the skin's own colour.
     if (!a.hair || (e.crown < options.bald && e.hairline <= options.hairlineStep)) out.style = HairStyle::None;
     else if (e.belowChin > options.long_ && e.besideFace > options.longBeside &&
              (!clothesLikeHair || e.downTheBack > options.longDownTheBack))
         out.style = HairStyle::Long;
-    else if (e.besideFace > options.beside) out.style = HairStyle::Bob;
-    else if (e.downTheBack > options.ponytail && e.behindHead > options.ponytail) out.style = HairStyle::Ponytail;
+    else if (e.besideFace > (tiedBack ? options.tiedBackBeside : options.beside)) out.style = HairStyle::Bob;
+    else if (tiedBack) out.style = HairStyle::Ponytail;
     else out.style = HairStyle::Short;
     if (out.style == HairStyle::None) out.colour = {0, 0, 0};
 

@@ -98,6 +98,10 @@ struct HairOptions {
     double clothesAsHair = 0.5;
     double longDownTheBack = 0.2;
     double beside = 0.2;         // besideFace over this (not long): a bob
+    // ... but over tiedBackBeside when the side photo shows hair tied back (a ponytail's windows, below): hair tied
+    // low leaves strands and the hair over the ears beside the jaw (FRMDB 004's low knot 0.43), a bob fills it
+    // (FRMDB 008 0.98, HairPopulation's bob 29 0.88). One example of each: set between them.
+    double tiedBackBeside = 0.65;
     // downTheBack and behindHead over this (nothing beside the face or neck): a ponytail. Measured (both windows,
     // the smaller): HairPopulation's ponytails 0.29-1.00, its short hair 0.00-0.01; FRMDB's short hair up to 0.14.
     double ponytail = 0.2;
