@@ -46,6 +46,7 @@ Hint sideHint(const SideObservation& obs) {
     if (obs.frontalFace) return std::abs(obs.frontalYaw) > kHalfTurnedYaw ? Hint::TurnMore : Hint::TurnRight;
     if (!obs.profileSeen) return obs.faceLooked && !obs.faceShows ? Hint::FaceHidden : Hint::TurnMore;
     if (obs.turnedBack) return Hint::TurnBack;
+    if (obs.turnedShort) return Hint::TurnMore;
     return Hint::HoldStill;
 }
 
@@ -145,6 +146,9 @@ SideObservation PreviewAnalyser::observeSide(const cv::Mat& bgr, const cv::Mat& 
             const ProfileTurn turn = estimateProfileTurn(bgr, frameMask, landmarks, obs.noseImageRight);
             if (turn.known) obs.turnDegrees = turn.degrees;
             obs.turnedBack = turn.pastProfile;
+            // The detector only where the eye and the ear already say "well short": a profile costs no more.
+            if (detector_ && !turn.pastProfile && turnedShortCues(turn))
+                obs.turnedShort = faceOnPerson(detector_->detectFaces(bgr), frameMask).has_value();
         }
     } else if (detector_) {
         // dlib's detector costs about 4x the cascade, so it runs only here, where the outline cannot say which way

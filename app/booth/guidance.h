@@ -69,6 +69,9 @@ struct SideObservation {
     double frontalYaw = 0.0;     // with frontalFace and a landmark detector: noseOffsetYaw of that face
     double turnDegrees = 0.0;    // with profileSeen: ProfileTurn::degrees (0 when unknown)
     bool turnedBack = false;     // with profileSeen: ProfileTurn::pastProfile
+    // With profileSeen and a landmark detector: the eye and the ear say turned well short (turnedShortCues) and
+    // dlib's detector finds the face on the person: "turn more" (about 60 degrees from the front).
+    bool turnedShort = false;
     // Without a profile and without the cascade's frontal face, with a landmark detector: whether dlib's detector
     // (whose filters also find faces looking aside) found a face on the person. None: turned well past the
     // profile, or hair hides the face.
@@ -80,7 +83,8 @@ struct SideObservation {
 // more" while half-turned (a frontal face turned more than kHalfTurnedYaw, or an outline without a profile whose
 // face still shows), "we can't see your face" when the outline has no profile and no face shows (turned well past
 // it, or hair over the face), "turn a little back" when the profile is seen turned clearly past it
-// (ProfileTurn::pastProfile: the ear and the eye agree), else "hold still" (either way: the fit takes both).
+// (ProfileTurn::pastProfile: the ear and the eye agree), "turn more" when it is seen turned well short of it (the
+// eye, the ear and the face agree), else "hold still" (either way: the fit takes both).
 Hint sideHint(const SideObservation& observation);
 
 // Runs the observations on preview frames. Holds the detectors; not thread-safe (one analyser per thread).

@@ -707,6 +707,11 @@ bool turnedPastProfile(double eyeDegrees, const EarPlace& ear) {
            ear.fold <= kEarFoldTurnBack && eyeDegrees >= kEyeTurnBackDegrees;
 }
 
+bool turnedShortCues(const ProfileTurn& turn) {
+    if (!turn.known || turn.degrees > kEyeTurnMoreDegrees) return false;
+    return !turn.ear.found || (turn.ear.headLength > 0.0 && turn.ear.front / turn.ear.headLength >= kEarShareTurnMore);
+}
+
 ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, const std::vector<ProfilePoint>& landmarks,
                                 bool noseImageRight) {
     ProfileTurn turn;
@@ -865,6 +870,16 @@ SideAnalysis analyseSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate
                                   90.0 + past, out.turn.ear.front / out.turn.ear.headLength, kEarShareAtProfile,
                                   past));
     }
+    if (options.refuseShortOfProfile && options.landmarkDetector && turnedShortCues(out.turn) &&
+        faceOnPerson(options.landmarkDetector->detectFaces(bgr), out.mask))
+        throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::TurnMore, "",
+                       cv::format("the side photo is turned short of the profile, about 60 degrees from the front (the "
+                                  "eye %.0f degrees short, the ear's front %s, and a face looking aside was found): "
+                                  "turn about 30 degrees more", -out.turn.degrees,
+                                  out.turn.ear.found ? cv::format("%.2f of the head's length behind the nose tip, about "
+                                                                  "%.2f in a profile", out.turn.ear.front /
+                                                                  out.turn.ear.headLength, kEarShareAtProfile).c_str()
+                                                     : "not found"));
     return out;
 }
 

@@ -113,6 +113,15 @@ inline constexpr double kEarShareAtProfile = 0.525;
 inline constexpr double kEarSharePerDegree = 0.0085;
 double degreesPastProfile(const EarPlace& ear);
 
+// Whether the eye and the ear both say the head is turned well short of the profile (about 60 degrees from the
+// front): the eye kEyeTurnMoreDegrees or more short, and the ear's front at kEarShareTurnMore of the head's length
+// or more behind the nose tip (or not found: a dark or textured cheek). On its own it is not enough (a visitor at 70
+// degrees reads -24 by the eye, 0.69 by the ear): the caller then looks for the face with dlib's detector, whose
+// filters for faces looking aside find it at 55-66 degrees and not past the profile (README, issue 22). Pure.
+bool turnedShortCues(const ProfileTurn& turn);
+inline constexpr double kEyeTurnMoreDegrees = -25.0;
+inline constexpr double kEarShareTurnMore = 0.67;
+
 struct SideAnalysis {
     cv::Mat mask;                        // CV_8U, 255 on the person (see segmentPerson)
     bool noseImageRight = true;          // the subject faces image-right
@@ -154,6 +163,9 @@ struct SideOptions {
     // Refuse a side photo turned past the profile (ProfileTurn::pastProfile, the cue on which the kiosk's side
     // guide says "turn a little back"): the same photo taken 20 degrees nearer the profile fits better.
     bool refusePastProfile = true;
+    // With landmarkDetector: refuse a side photo turned well short of the profile (turnedShortCues, and dlib's
+    // detector finds the face looking aside; the side guide's "turn more" on the same cues), fault TurnMore.
+    bool refuseShortOfProfile = true;
 };
 
 // A face's turn from the front by its 68 points: the nose tip's offset from the middle of the eyes' outer corners,
