@@ -135,11 +135,12 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
                 withHair);
     // With MakeHuman's hair proxies in the photos: a fringe or a quiff standing as far forward as the nose was taken
     // for it, and 5 clean profiles were refused (3, 7, 27, 33, 35: "nasion 0.45 V above the nose tip", "no nose-like
-    // forward bulge"); the profile analysis now tries the next bulge (fitProfile). Still refused: the three bobs
-    // whose hair hides the profile (9, 20, 34), told so (they were told "a front view"). The profile's points are where the truth has them: every nose tip
-    // within 6 px (3.6 mm) but one (36, whose full lips stand 2 px further forward than her nose), every nasion within
-    // 10 px but one (29, whose bob's fringe covers the forehead down to the brows: the nasion is taken under it),
-    // as before the fringes were told from noses. The rest is what held when this was written.
+    // forward bulge"); the profile analysis now tries the next bulge (fitProfile). Still refused: the three bobs whose
+    // hair hides the profile (9, 20, 34), told so (they were told "a front view"). The profile's points are where the
+    // truth has them: every nose tip within 6 px (3.6 mm) but one (36, whose full lips stand 2 px further forward than
+    // her nose), every nasion within 10 px but one (29, whose bob's fringe covers the forehead down to the brows: the
+    // nasion is taken under it), as before the fringes were told from noses. The rest is what held when this was
+    // written.
     const int analysed = static_cast<int>(kPeople) - refused;
     std::printf("profile: of %d, %d nose tips within 6 px of the truth, %d nasions within 10 px\n", analysed, tipsNear,
                 nasionsNear);

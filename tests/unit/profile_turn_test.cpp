@@ -1,5 +1,5 @@
-// The side photo's turn past the profile: the ear read from its columns of skin folds, and the rule that joins it
-// to the eye (fit/face/profile.h).
+// The side photo's turn past or short of the profile: the ear read from its columns of skin folds, and the rules
+// that join it to the eye (fit/face/profile.h).
 #include "fit/face/profile.h"
 
 #include <gtest/gtest.h>
@@ -11,7 +11,9 @@ namespace {
 using avatarbooth::degreesPastProfile;
 using avatarbooth::EarPlace;
 using avatarbooth::readEarColumns;
+using avatarbooth::ProfileTurn;
 using avatarbooth::turnedPastProfile;
+using avatarbooth::turnedShortCues;
 
 // 100 columns of 0.01 V behind the nasion at `cheek`, with an ear of `ear` in columns 40-49 (0.40-0.50 V).
 std::vector<double> columnsWithEar(double cheek, double ear) {
@@ -88,4 +90,29 @@ TEST(ProfileTurn, DegreesPastTheProfileFromTheEarsShare) {
     EXPECT_DOUBLE_EQ(degreesPastProfile(ear), 0.0);
     ear.found = false;
     EXPECT_DOUBLE_EQ(degreesPastProfile(ear), 0.0);
+}
+
+TEST(TurnedShortCues, NeedTheEyeWellShortAndTheEarFarBackOrUnseen) {
+    ProfileTurn turn;
+    turn.known = true;
+    turn.degrees = -25.0;  // exactly kEyeTurnMoreDegrees
+    turn.ear.found = true;
+    turn.ear.headLength = 1.4;
+    turn.ear.front = 0.67 * 1.4;  // exactly kEarShareTurnMore of the head
+    EXPECT_TRUE(turnedShortCues(turn));
+    ProfileTurn eye = turn;
+    eye.degrees = -24.9;
+    EXPECT_FALSE(turnedShortCues(eye)) << "the eye not far enough short (a visitor at 70 degrees: -24)";
+    ProfileTurn ear = turn;
+    ear.ear.front = 0.66 * 1.4;
+    EXPECT_FALSE(turnedShortCues(ear)) << "the ear nearer the face than at 60 degrees";
+    ProfileTurn unseen = turn;
+    unseen.ear.found = false;  // a dark or textured cheek: the eye and the face decide
+    EXPECT_TRUE(turnedShortCues(unseen));
+    ProfileTurn unknown = turn;
+    unknown.known = false;
+    EXPECT_FALSE(turnedShortCues(unknown)) << "no eye read: nothing to say";
+    ProfileTurn noLength = turn;
+    noLength.ear.headLength = 0.0;
+    EXPECT_FALSE(turnedShortCues(noLength));
 }
