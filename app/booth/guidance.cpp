@@ -132,33 +132,30 @@ SideObservation PreviewAnalyser::observeSide(const cv::Mat& bgr, const cv::Mat& 
     std::vector<cv::Point2d> outline;
     for (const auto& p : largestOutline(mask)) outline.emplace_back(p.x, p.y);
     const ProfileFit right = fitProfile(outline, true), left = fitProfile(outline, false);
-    if (right.ok || left.ok) {
-        obs.noseImageRight = right.ok && (!left.ok || right.noseProminence >= left.noseProminence);
-        const ProfileFit& fit = obs.noseImageRight ? right : left;
-        obs.noseProminence = fit.noseProminence;
-        obs.profileSeen = true;
-        if (fit.ok) {
-            // The ear's folds are a few pixels wide at the preview's size: the turn is read on the frame itself.
-            std::vector<ProfilePoint> landmarks = fit.landmarks;
-            for (auto& p : landmarks) p.px = p.px / scale;
-            cv::Mat frameMask;
-            cv::resize(mask, frameMask, bgr.size(), 0, 0, cv::INTER_NEAREST);
-            const ProfileTurn turn = estimateProfileTurn(bgr, frameMask, landmarks, obs.noseImageRight);
-            if (turn.known) obs.turnDegrees = turn.degrees;
-            obs.turnedBack = turn.pastProfile;
-            // The detector only where the eye and the ear already say "well short": a profile costs no more.
-            if (detector_ && !turn.pastProfile && turnedShortCues(turn))
-                obs.turnedShort = faceOnPerson(detector_->detectFaces(bgr), frameMask).has_value();
-        }
-    } else if (detector_) {
-        // dlib's detector costs about 4x the cascade, so it runs only here, where the outline cannot say which way
-        // the visitor should turn (face/profile.h, analyseSidePhoto does the same). On the frame: a face at the
-        // preview's size is below dlib's 80 px.
-        cv::Mat frameMask;
-        cv::resize(mask, frameMask, bgr.size(), 0, 0, cv::INTER_NEAREST);
+    const bool profile = right.ok || left.ok;
+    if (!profile && !detector_) return obs;
+    // The ear's folds are a few pixels wide at the preview's size, and a face there is below dlib's 80 px: the turn
+    // and the face are read on the frame itself.
+    cv::Mat frameMask;
+    cv::resize(mask, frameMask, bgr.size(), 0, 0, cv::INTER_NEAREST);
+    if (!profile) {
+        // dlib's detector costs about 4x the cascade, so it runs only where the outline cannot say which way the
+        // visitor should turn (analyseSidePhoto does the same).
         obs.faceLooked = true;
-        obs.faceShows = faceOnPerson(detector_->detectFaces(bgr), frameMask).has_value();
+        obs.faceShows = faceOnPerson(*detector_, bgr, frameMask).has_value();
+        return obs;
     }
+    obs.noseImageRight = right.ok && (!left.ok || right.noseProminence >= left.noseProminence);
+    const ProfileFit& fit = obs.noseImageRight ? right : left;  // one with a nose: `profile`
+    obs.noseProminence = fit.noseProminence;
+    obs.profileSeen = true;
+    std::vector<ProfilePoint> landmarks = fit.landmarks;
+    for (auto& p : landmarks) p.px = p.px / scale;
+    const ProfileTurn turn = estimateProfileTurn(bgr, frameMask, landmarks, obs.noseImageRight);
+    if (turn.known) obs.turnDegrees = turn.degrees;
+    obs.turnedBack = turn.pastProfile;
+    // The detector only where the eye and the ear already say "well short": a profile costs no more.
+    if (detector_ && turnedShortCues(turn)) obs.turnedShort = faceOnPerson(*detector_, bgr, frameMask).has_value();
     return obs;
 }
 

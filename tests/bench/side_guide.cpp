@@ -1,9 +1,9 @@
 // The side guide's analysis of one preview frame (PreviewAnalyser::observeSide, 972x720 as the simulated camera's
 // preview stream gives it) for a MakeHuman visitor turned 90 degrees (a profile: outline, turn cues), 60 degrees
 // with no nose on the outline (dlib's face detector runs and finds the face looking aside: "turn more") and 120
-// degrees with none (it runs and finds nothing: "we can't see your face"). The frames without a profile cost the detector on
-// top; the kiosk analyses the latest frame while the guide draws at the display's rate. Prints figures; never fails
-// on speed.
+// degrees with none (it runs and finds nothing: "we can't see your face"). The frames without a profile cost the
+// detector on top; the kiosk analyses the latest frame while the guide draws at the display's rate. Prints figures;
+// never fails on speed.
 #include "booth/guidance.h"
 #include "fit/face/landmarks68.h"
 #include "fit/head/base_head.h"

@@ -149,6 +149,9 @@ TEST(Guidance, SideHintSaysWhichWayToTurn) {
     EXPECT_EQ(sideHint(o), Hint::HoldStill);
     o.turnedBack = true;  // the ear and the eye agree
     EXPECT_EQ(sideHint(o), Hint::TurnBack);
+    o.turnedBack = false;
+    o.turnedShort = true;  // the eye, the ear and dlib's face agree: well short of the profile
+    EXPECT_EQ(sideHint(o), Hint::TurnMore);
 }
 
 TEST(Guidance, SideHintWithoutAProfileFollowsTheFace) {

@@ -403,8 +403,8 @@ HairEstimate estimateHair(const HairPhotos& photos, const HairOptions& options) 
     // Long hair shows beside the neck in the front photo (unless the clothes there are of its colour: then the side
     // photo's hair down the back says it); a ponytail only down the back in the side photo, with
     // nothing beside the face, hanging from the back of the head down (a dark shirt under short hair fills the lower
-    // window alone); a bob beside the face down to the jaw (filling it, when the side shows hair tied back). The side's windows sit where hoods and collars
-    // often are, so the front decides where it can.
+    // window alone); a bob beside the face down to the jaw (filling it, when the side shows hair tied back). The
+    // side's windows sit where hoods and collars often are, so the front decides where it can.
     // Few crown pixels unlike skin is no hair, unless a hairline shows: hair of the skin's own colour.
     if (!a.hair || (e.crown < options.bald && e.hairline <= options.hairlineStep)) out.style = HairStyle::None;
     else if (e.belowChin > options.long_ && e.besideFace > options.longBeside &&

@@ -772,8 +772,8 @@ ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, con
     return turn;
 }
 
-std::optional<cv::Rect> faceOnPerson(const std::vector<cv::Rect>& faces, const cv::Mat& personMask) {
-    for (const cv::Rect& f : faces) {
+std::optional<cv::Rect> faceOnPerson(const LandmarkDetector& detector, const cv::Mat& bgr, const cv::Mat& personMask) {
+    for (const cv::Rect& f : detector.detectFaces(bgr)) {  // largest first
         const cv::Point c(f.x + f.width / 2, f.y + f.height / 2);
         if (c.inside(cv::Rect(0, 0, personMask.cols, personMask.rows)) && personMask.at<unsigned char>(c)) return f;
     }
@@ -828,7 +828,7 @@ SideAnalysis analyseSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate
         // Which way to turn: the outline cannot say (see ProfileTurn), the face can. dlib's HOG detector, with its
         // filters for faces looking aside, finds the face of every synthetic visitor turned 55-66 degrees and of
         // none turned 114-150 (README, issue 22); a bob hiding the face shows none either.
-        const auto face = faceOnPerson(options.landmarkDetector->detectFaces(bgr), out.mask);
+        const auto face = faceOnPerson(*options.landmarkDetector, bgr, out.mask);
         if (!face)
             throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::FaceHidden, "",
                            "no face shows in the side photo (" + noNose + "; no face found on the head): turned past "
@@ -871,7 +871,7 @@ SideAnalysis analyseSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate
                                   past));
     }
     if (options.refuseShortOfProfile && options.landmarkDetector && turnedShortCues(out.turn) &&
-        faceOnPerson(options.landmarkDetector->detectFaces(bgr), out.mask))
+        faceOnPerson(*options.landmarkDetector, bgr, out.mask))
         throw FitError(ErrorKind::Mismatch, FitPhoto::Side, FitFault::TurnMore, "",
                        cv::format("the side photo is turned short of the profile, about 60 degrees from the front (the "
                                   "eye %.0f degrees short, the ear's front %s, and a face looking aside was found): "

@@ -171,9 +171,10 @@ struct SideOptions {
 // A face's turn from the front by its 68 points: the nose tip's offset from the middle of the eyes' outer corners,
 // along the eye line, in eye widths (positive: the nose towards image-right). The front guide's measure.
 double noseOffsetYaw(const std::array<cv::Point2d, 68>& points);
-// The first of `faces` (largest first, as LandmarkDetector::detectFaces gives them) whose box's centre lies on the
-// person (personMask: CV_8U, non-zero on the person); a face on a poster behind the visitor does not count.
-std::optional<cv::Rect> faceOnPerson(const std::vector<cv::Rect>& faces, const cv::Mat& personMask);
+// The largest face dlib's detector (LandmarkDetector::detectFaces, whose filters also find faces looking aside) finds
+// in `bgr` whose box's centre lies on the person (personMask: CV_8U, non-zero on the person, of the photo's size);
+// a face on a poster behind the visitor does not count.
+std::optional<cv::Rect> faceOnPerson(const LandmarkDetector& detector, const cv::Mat& bgr, const cv::Mat& personMask);
 
 // Beyond this |noseOffsetYaw| a face is half-turned (the front guide's maxYaw: frmdb's fronts -0.23 to 0.15, its
 // 45-degree views 0.28-0.38 where the frontal cascade still finds them).
