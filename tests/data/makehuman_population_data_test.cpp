@@ -325,11 +325,11 @@ TEST(MakeHumanPopulation, FitsEveryPersonWithoutFoldsAndWithinTheMeasuredShapeEr
     std::printf("\n");
     std::printf("issue 21's goal, median face RMS under 1 mm with ground-truth landmarks and under 1.5 mm with detected "
                 "ones: %s, %s\n", median(truthRms) < 1.0 ? "met" : "not yet", median(detectedRms) < 1.5 ? "met" : "not yet");
-    // Measured on the 60 people: every fit made, no failure; medians base head 3.55 mm, ground-truth landmarks
-    // 1.11 mm, detected 2.05 mm.
+    // Measured on the 60 people (README, "How near the fit comes"): every fit made; medians base head 3.55 mm,
+    // ground-truth landmarks 0.99 mm, detected 1.57 mm. The limits leave room for another Debian's dlib and OpenCV.
     EXPECT_EQ(truthFailures, 0);
     EXPECT_LE(detectedFailures, 3);
-    EXPECT_LT(median(truthRms), 1.4);
-    EXPECT_LT(median(detectedRms), 2.4);
+    EXPECT_LT(median(truthRms), 1.1);
+    EXPECT_LT(median(detectedRms), 1.75);
     EXPECT_LT(median(detectedRms), 0.85 * median(baseRms)) << "the fit must come nearer the truth than the average head";
 }

@@ -64,6 +64,31 @@ TEST(ModifierFit, RecoversKnownWeightsScaleAndShift) {
     EXPECT_LT(f.rmsAfterMm, 1e-4);
 }
 
+TEST(ModifierFit, RecoversTheHeadsSizeWhenItIsLeftFree) {
+    const Problem p = makeProblem();
+    const std::vector<double> truth = {0.3, 0.0, 0.85, 0.5};
+    const glm::dvec3 scale(1.0), centre(0.0, 2.0, -3.0), shift(4.0, -2.5, 1.5);
+    // The targets come from a head 4 % larger than the scaling the fit is given.
+    const auto targets = targetsFor(p, truth, 1.04 * scale, centre, shift);
+    ModifierFitOptions o;
+    o.regularisation = 1e-9;
+    o.scaleRegularisation = 1e-9;
+    const ModifierFit free = fitModifiers(p.basis, p.base, scale, centre, targets, o);
+    // sigma enters linearly: its product with the weights' offsets (4 % of up to 7 mm) is what remains.
+    EXPECT_NEAR(free.scaleChange, 0.04, 0.002);
+    EXPECT_NEAR(free.translation.x, shift.x, 0.3);
+    EXPECT_LT(free.rmsAfterMm, 0.2);
+    for (std::size_t k = 0; k < truth.size(); ++k) EXPECT_NEAR(free.weights[k], truth[k], 0.05) << k;
+    // Held (range 0), the size cannot follow, and the weights and the shift take the difference.
+    o.scaleRange = 0.0;
+    const ModifierFit held = fitModifiers(p.basis, p.base, scale, centre, targets, o);
+    EXPECT_EQ(held.scaleChange, 0.0);
+    EXPECT_GT(held.rmsAfterMm, 5.0 * free.rmsAfterMm);
+    // Within its range: asked for 4 %, allowed 2 %, it stops at 2 %.
+    o.scaleRange = 0.02;
+    EXPECT_DOUBLE_EQ(fitModifiers(p.basis, p.base, scale, centre, targets, o).scaleChange, 0.02);
+}
+
 TEST(ModifierFit, WeightsStayWithinTheirRange) {
     const Problem p = makeProblem();
     // Asked for 2.5 of the first modifier and "-1" of the second: the bounds hold them at 1 and 0.
@@ -175,6 +200,7 @@ TEST(ModifierFit, ReachesTheBoundedOptimum) {
     o.regularisation = 2.0;
     o.robustMm = 0.0;
     o.fixedGroups.clear();
+    o.scaleRange = 0.0;  // the size held: the objective below has no sigma
     const ModifierFit f = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
     const auto objective = [&](const std::vector<double>& weights, const glm::dvec3& shift) {
         const auto shaped = p.basis.apply(p.base, weights);

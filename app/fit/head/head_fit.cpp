@@ -443,6 +443,7 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
                                            options.modifiers);
         shaped.positions = base.modifiers->apply(base.mesh.positions, m.weights);
         frameShift += m.translation;
+        fit.axisScale *= 1.0 + m.scaleChange;
         fit.modifierWeights.clear();
         for (std::size_t k = 0; k < m.weights.size(); ++k)
             if (m.weights[k] > 1e-4) fit.modifierWeights.emplace_back(base.modifiers->modifiers[k].name, m.weights[k]);

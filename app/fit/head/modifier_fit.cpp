@@ -92,7 +92,7 @@ ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec
                          const glm::dvec3& centre, const std::vector<ModifierTarget>& targets,
                          const ModifierFitOptions& options) {
     const std::size_t K = basis.modifiers.size();
-    const std::size_t n = K + 3;  // the weights, then t_x, t_y, t_z
+    const std::size_t n = K + 4;  // the weights, then t_x, t_y, t_z, sigma
     const std::size_t rows = 2 * targets.size();
     // Residuals at w = 0 and the design matrix, row-major rows x n.
     std::vector<double> r0(rows), A(rows * n, 0.0);
@@ -108,9 +108,11 @@ ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec
         const glm::dvec2 d = t.target - now;
         r0[2 * i] = glm::dot(e0, d);
         r0[2 * i + 1] = glm::dot(e1, d);
+        const glm::dvec2 fromCentre = projectToView(p - centre, t.view);  // what sigma = 1 adds
         for (const auto& [row, e] : {std::pair{2 * i, e0}, std::pair{2 * i + 1, e1}}) {
             A[row * n + K + (t.view == View::Front ? 0 : 2)] = e.x;  // t_x moves front a, t_z side a
             A[row * n + K + 1] = e.y;                                 // t_y moves b in both
+            A[row * n + K + 3] = glm::dot(e, fromCentre);
         }
     }
     for (std::size_t k = 0; k < K; ++k) {
@@ -131,12 +133,14 @@ ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec
                    options.fixedGroups.end();
     // Iteratively reweighted least squares (Huber): after each solve a target whose error exceeds robustMm counts
     // with weight robustMm / error, so that one misplaced point (a chin found on the lip) cannot bend the head.
-    // The box: modifiers within their slider range (held ones at 0), the translation free.
+    // The box: modifiers within their slider range (held ones at 0), the translation free, the size within its range.
     std::vector<double> lower(n, -std::numeric_limits<double>::infinity()), upper(n, std::numeric_limits<double>::infinity());
     for (std::size_t k = 0; k < K; ++k) {
         lower[k] = 0.0;
         upper[k] = fixed[k] ? 0.0 : 1.0;
     }
+    lower[K + 3] = -std::max(0.0, options.scaleRange);
+    upper[K + 3] = std::max(0.0, options.scaleRange);
     std::vector<double> w(n, 0.0), rowWeight(rows, 1.0);
     const int solves = options.robustMm > 0.0 ? 1 + options.robustIterations : 1;
     for (int solve = 0; solve < solves; ++solve) {
@@ -169,11 +173,13 @@ ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec
             N[k * n + k] += group != options.groupRegularisation.end() ? group->second : options.regularisation;
         }
         for (std::size_t i = K; i < n; ++i) N[i * n + i] += 1e-9;
+        N[(K + 3) * n + K + 3] += options.scaleRegularisation;
         minimiseInBox(N, g, lower, upper, w, options.maxNewtonSteps);
     }
     ModifierFit fit;
     fit.weights.assign(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(K));
     fit.translation = {w[K], w[K + 1], w[K + 2]};
+    fit.scaleChange = w[K + 3];
     double before = 0.0, after = 0.0;
     for (std::size_t r = 0; r < rows; ++r) {
         double pred = 0.0;

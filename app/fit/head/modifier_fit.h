@@ -2,9 +2,10 @@
 // nearest their measured positions, as a bounded, regularised linear least-squares problem (the shape fitting of
 // eos, Huber et al. 2016, with MakeHuman's targets for the morphable model's basis).
 //
-// Model: vertex v at weights w is c + S (b_v + sum_k w_k d_kv - c), seen in the front view as (x, y) and in the side
-// view as (z, y), plus a translation (t_x, t_y, t_z) of the photos' frames against the head (the frames are placed
-// by the eye midpoint and the ear hole of the head before its shape is known). Minimised:
+// Model: vertex v at weights w is c + S (1 + sigma) (b_v + sum_k w_k d_kv - c), seen in the front view as (x, y) and
+// in the side view as (z, y), plus a translation (t_x, t_y, t_z) of the photos' frames against the head (the frames
+// are placed by the eye midpoint and the ear hole of the head before its shape is known); sigma's product with the
+// weights is left out (linearised: a second-order term of a few per cent of a few millimetres). Minimised:
 //   sum over targets |projected vertex - target|^2 + lambda sum_k w_k^2,  0 <= w_k <= 1,
 // (for an outline target, the error's parts along its normal and along the outline, each with its weight),
 // so w = 0 (the average head) is what the photos must argue the head away from.
@@ -47,11 +48,20 @@ struct ModifierFitOptions {
     // Modifier groups held at 0: the ears, which no photo measurement sees (the outline rays pass above and below
     // them), would otherwise be bent to fit rays that meet hair.
     std::vector<std::string> fixedGroups = {"ears"};
+    // The head's size, as one more unknown: a uniform change sigma of the given scaling about its centre,
+    // within +-scaleRange, costing scaleRegularisation * sigma^2 (square millimetres). The scaling the head fit starts
+    // from is one width (dlib's jaw points 0 and 16, a few pixels off on a photo, and wider or narrower against the
+    // eyes from one person to the next); all the targets together say the size better. 0: the size is held.
+    // At 20000 a change of 5 % costs 50 mm^2, more than a modifier at full weight: on the booth's fits the size
+    // moves by about 1 % (README, "How near the fit comes", has the figures).
+    double scaleRange = 0.15;
+    double scaleRegularisation = 20000.0;
 };
 
 struct ModifierFit {
     std::vector<double> weights;       // one per modifier, in [0, 1]
     glm::dvec3 translation{0.0};       // of the frames, millimetres
+    double scaleChange = 0.0;          // sigma: the head is the given scaling times (1 + sigma) about the centre
     double rmsBeforeMm = 0.0, rmsAfterMm = 0.0;  // over the targets, at w = 0 and at the solution
 };
 
