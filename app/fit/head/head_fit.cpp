@@ -320,7 +320,8 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         const double depthBase = pos("glabella").z - pos("back_of_head").z;
         // Measured once, on the base head: in later rounds the modifiers change the extents, and scaling them back
         // to the measured ones would undo what the modifiers found. With a modifier basis the head is scaled
-        // uniformly by the face's width (dlib's jaw line: no hair in it) and the modifiers (the head's own
+        // uniformly by the face's width (dlib's jaw line: no hair in it) to start with, each round's modifier fit
+        // correcting that size (ModifierFit::scaleChange), and the modifiers (the head's own
         // scale-vert/-depth among them) take its proportions from the landmarks; the height and depth include the
         // hair, and scaling by them stretched the face. They still say whether it is a head at all.
         if (round == 0) {

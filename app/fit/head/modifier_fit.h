@@ -6,7 +6,8 @@
 // in the side view as (z, y), plus a translation (t_x, t_y, t_z) of the photos' frames against the head (the frames
 // are placed by the eye midpoint and the ear hole of the head before its shape is known); sigma's product with the
 // weights is left out (linearised: a second-order term of a few per cent of a few millimetres). Minimised:
-//   sum over targets |projected vertex - target|^2 + lambda sum_k w_k^2,  0 <= w_k <= 1,
+//   sum over targets |projected vertex - target|^2 + lambda sum_k w_k^2 + lambda_s sigma^2,  0 <= w_k <= 1,
+//   |sigma| <= scaleRange,
 // (for an outline target, the error's parts along its normal and along the outline, each with its weight),
 // so w = 0 (the average head) is what the photos must argue the head away from.
 #pragma once
