@@ -216,7 +216,11 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     });
     out.partColours = measurePartColours(front, out.frontLandmarks);
     out.parts = placeParts(base_, out.fit.mesh, out.texture.texture, out.partColours);
-    if (auto hair = placeHairPart(base_, out.fit.mesh, out.hair)) out.parts.push_back(std::move(*hair));
+    if (auto hair = placeHairPart(base_, out.fit.mesh, out.hair)) {
+        // The photo showed the face (its landmarks were all found): the avatar's hair leaves it clear too.
+        keepFaceClear(hair->mesh, base_, out.fit.mesh);
+        out.parts.push_back(std::move(*hair));
+    }
     // The brows onto the photo's own (which the texture shows where the fit put dlib's brow points): dlib puts them on
     // a brow's upper half, about 1.5 mm over its middle (the FRMDB overlays).
     std::vector<glm::dvec2> browPoints;

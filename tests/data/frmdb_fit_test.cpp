@@ -5,6 +5,7 @@
 
 #include "fit/export/glb.h"
 #include "booth/session_folder.h"
+#include "common/landmark_names.h"
 #include "fit/fit_pipeline.h"
 #include "fit/head/folds.h"
 #include "render/mesh_renderer.h"
@@ -28,6 +29,21 @@ const FitPipeline& pipeline() {
 MeshRenderer& renderer() {
     static MeshRenderer r;
     return r;
+}
+
+// Whether a triangle of `part` lies over `p` seen from the front (+z): it covers p's (x, y) ahead of p.
+bool coveredFromTheFront(const Mesh& part, const glm::dvec3& p) {
+    for (const auto& t : part.triangles) {
+        const glm::dvec3 &a = part.positions[t.x], &b = part.positions[t.y], &c = part.positions[t.z];
+        const double det = (b.y - c.y) * (a.x - c.x) + (c.x - b.x) * (a.y - c.y);
+        if (std::abs(det) < 1e-12) continue;
+        const double l0 = ((b.y - c.y) * (p.x - c.x) + (c.x - b.x) * (p.y - c.y)) / det;
+        const double l1 = ((c.y - a.y) * (p.x - c.x) + (a.x - c.x) * (p.y - c.y)) / det;
+        const double l2 = 1.0 - l0 - l1;
+        if (l0 < 0.0 || l1 < 0.0 || l2 < 0.0) continue;
+        if (l0 * a.z + l1 * b.z + l2 * c.z > p.z) return true;
+    }
+    return false;
 }
 
 }  // namespace
@@ -67,6 +83,16 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
     const Mesh back = readGlbMesh(out / "avatar.glb");
     ASSERT_FALSE(outcome.parts.empty());
     EXPECT_EQ(back.positions.size(), outcome.parts.front().mesh.positions.size());
+    // The face the photo shows is not hidden by the hair in the front view: its eyes, nose and mouth (ibug 27-67)
+    // (bob02's fringe fell over 008's eye before the hair kept the face clear).
+    for (const auto& part : outcome.parts) {
+        if (part.name != "hair") continue;
+        std::vector<std::string> covered;
+        for (int k = 27; k < 68; ++k)
+            if (coveredFromTheFront(part.mesh, mesh.positions[pipeline().baseHead().frontFeatures.at(landmarkName(k))]))
+                covered.push_back(landmarkName(k));
+        EXPECT_TRUE(covered.empty()) << "hair in front of " << ::testing::PrintToString(covered);
+    }
     std::printf("%s %s: parts", person, std::get<1>(GetParam()));
     for (const auto& part : outcome.parts) std::printf(" %s", part.name.c_str());
     for (const auto& [name, c] : outcome.partColours) std::printf("; %s (%.0f %.0f %.0f)", name.c_str(), c[0], c[1], c[2]);

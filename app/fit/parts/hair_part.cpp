@@ -1,13 +1,39 @@
 // The hair part (hair_part.h).
 #include "fit/parts/hair_part.h"
 
+#include "common/error.h"
+#include "common/landmark_names.h"
 #include "fit/parts/avatar_parts.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace avatarbooth {
+
+void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, const FaceClearance& clearance) {
+    const auto at = [&](int k) -> const glm::dvec3& {
+        const auto it = base.frontFeatures.find(landmarkName(k));
+        if (it == base.frontFeatures.end() || it->second >= fittedHead.positions.size())
+            throw BoothError(ErrorKind::Internal, "hair part", "the base head has no feature vertex " + landmarkName(k));
+        return fittedHead.positions[it->second];
+    };
+    double browY = at(17).y;
+    for (int k = 18; k <= 26; ++k) browY = std::min(browY, at(k).y);
+    const double sideZ = 0.5 * (at(0).z + at(16).z) + clearance.aheadOfJaw;
+    for (glm::dvec3& p : hair.positions) {
+        if (p.z <= sideZ) continue;
+        // 0 from `ramp` over the brows up, 1 from the brows down, smooth between (no crease in a strand).
+        const double t = std::clamp((browY + clearance.ramp - p.y) / clearance.ramp, 0.0, 1.0);
+        // Ahead of the plane, depth is compressed into `depth` millimetres, keeping its order: the strands stay
+        // layered as they were, not collapsed onto one flat wall.
+        const double ahead = p.z - sideZ;
+        const double kept = clearance.depth * (1.0 - std::exp(-ahead / clearance.depth));
+        p.z -= t * t * (3.0 - 2.0 * t) * (ahead - kept);
+    }
+}
 
 const char* hairProxyName(HairStyle style) {
     switch (style) {
