@@ -7,7 +7,7 @@
 namespace avatarbooth {
 
 inline std::string landmarkName(int k) {
-    char name[16];
+    char name[24];  // room for any int, which the compiler checks
     std::snprintf(name, sizeof name, "ibug_%02d", k);
     return name;
 }

@@ -248,7 +248,10 @@ TEST(MakeHumanPopulation, FitsEveryPersonWithoutFoldsAndWithinTheMeasuredShapeEr
             m.frontMask = segmentPerson(v.front, v.background);
             m.sideMask = segmentPerson(v.side, v.background);
             m.sideNoseImageRight = options.sideNoseImageRight;
-            truth = measure(fitHead(*base, m, pipeline.settings().head), v.truthMesh, face, options.mmPerPixel);
+            // Exact points: each is measured both ways (HeadFitOptions::frontLandmarksByHeight).
+            HeadFitOptions exact = pipeline.settings().head;
+            exact.frontLandmarksByHeight.clear();
+            truth = measure(fitHead(*base, m, exact), v.truthMesh, face, options.mmPerPixel);
             truthRms.push_back(truth.rmsMm);
             truthOwnScale.push_back(truth.rmsOwnScaleMm);
             truthFolds += truth.folds;
@@ -326,10 +329,53 @@ TEST(MakeHumanPopulation, FitsEveryPersonWithoutFoldsAndWithinTheMeasuredShapeEr
     std::printf("issue 21's goal, median face RMS under 1 mm with ground-truth landmarks and under 1.5 mm with detected "
                 "ones: %s, %s\n", median(truthRms) < 1.0 ? "met" : "not yet", median(detectedRms) < 1.5 ? "met" : "not yet");
     // Measured on the 60 people (README, "How near the fit comes"): every fit made; medians base head 3.55 mm,
-    // ground-truth landmarks 0.99 mm, detected 1.57 mm. The limits leave room for another Debian's dlib and OpenCV.
+    // ground-truth landmarks 0.99 mm, detected 1.51 mm. The limits leave room for another Debian's dlib and OpenCV.
     EXPECT_EQ(truthFailures, 0);
     EXPECT_LE(detectedFailures, 3);
     EXPECT_LT(median(truthRms), 1.1);
-    EXPECT_LT(median(detectedRms), 1.75);
+    EXPECT_LT(median(detectedRms), 1.7);
     EXPECT_LT(median(detectedRms), 0.85 * median(baseRms)) << "the fit must come nearer the truth than the average head";
+}
+
+// The middle brow points are measured by their height (HeadFitOptions::frontLandmarksByHeight): moving them 5 mm
+// sideways in the photo, as dlib's convention does, leaves the fitted brows where they were; measured both ways,
+// the same shift drags them.
+TEST(MakeHumanPopulation, ASidewaysShiftOfTheMiddleBrowPointsLeavesTheBrowsWhereTheyWere) {
+    if (findMakeHumanBaseHead().empty()) GTEST_SKIP() << "the MakeHuman base head is not built";
+    const auto base = productBaseHead();
+    MeshRenderer renderer;
+    MakeHumanVisitorOptions options;
+    options.seed = 7;
+    const MakeHumanVisitor person = makeMakeHumanVisitor(*base, renderer, options);
+    const SyntheticVisitor& v = person.photos;
+    PhotoMeasurements m;
+    m.frontPoints = v.frontLandmarks;
+    m.sidePoints = v.sideLandmarks;
+    m.frontMask = segmentPerson(v.front, v.background);
+    m.sideMask = segmentPerson(v.side, v.background);
+    m.sideNoseImageRight = options.sideNoseImageRight;
+    PhotoMeasurements shifted = m;
+    // Towards the nose: the person's right brow (18-20) is on the photo's left.
+    const double px = 5.0 / options.mmPerPixel;
+    for (const int k : {18, 19, 20}) shifted.frontPoints[landmarkName(k)].x += px;
+    for (const int k : {23, 24, 25}) shifted.frontPoints[landmarkName(k)].x -= px;
+
+    const auto browShiftMm = [&](const HeadFitOptions& o) {
+        const HeadFit a = fitHead(*base, m, o), b = fitHead(*base, shifted, o);
+        double largest = 0.0;
+        for (const int k : {18, 19, 20, 23, 24, 25}) {
+            const std::uint32_t vertex = base->frontFeatures.at(landmarkName(k));
+            largest = std::max(largest, std::abs(b.mesh.positions[vertex].x - a.mesh.positions[vertex].x));
+        }
+        return largest;
+    };
+    const HeadFitOptions byHeight = defaultHeadFitOptions();
+    HeadFitOptions bothWays = byHeight;
+    bothWays.frontLandmarksByHeight.clear();
+    const double held = browShiftMm(byHeight), dragged = browShiftMm(bothWays);
+    std::printf("middle brow points shifted 5 mm towards the nose: the fitted brow vertices move %.2f mm sideways "
+                "measured by height, %.2f mm measured both ways\n", held, dragged);
+    // Measured: 0.26 mm against 1.76 (the warp's ridge and the modifiers' regularisation take the rest of the 5 mm).
+    EXPECT_LT(held, 0.5);
+    EXPECT_GT(dragged, 1.0);
 }

@@ -115,17 +115,19 @@ struct ViewTargets {
     // in this view is kept, so that the surface is pushed out or in, never dragged along itself (which folds it).
     void add(const Mesh& mesh, const std::string& name, std::uint32_t v, glm::dvec2 target,
              const std::vector<glm::dvec3>* normals = nullptr) {
+        addAcross(mesh, name, v, target, normals ? projectToView((*normals)[v], view) : glm::dvec2(0.0));
+    }
+    // The same with the normal in this view's plane given: only the target's component along it is kept (zero: the
+    // point is measured both ways).
+    void addAcross(const Mesh& mesh, const std::string& name, std::uint32_t v, glm::dvec2 target, const glm::dvec2& normal) {
         if (!used.insert(v).second) return;
         const glm::dvec3 c = mesh.positions[v];
         const glm::dvec2 now = projectToView(c, view);
         glm::dvec2 outlineNormal(0.0);
         measured.push_back(target);
-        if (normals) {
-            const glm::dvec2 n = projectToView((*normals)[v], view);
-            if (glm::length(n) > 1e-6) {
-                outlineNormal = glm::normalize(n);
-                target = now + outlineNormal * glm::dot(outlineNormal, target - now);
-            }
+        if (glm::length(normal) > 1e-6) {
+            outlineNormal = glm::normalize(normal);
+            target = now + outlineNormal * glm::dot(outlineNormal, target - now);
         }
         outlineNormals.push_back(outlineNormal);
         centres.push_back(c);
@@ -225,6 +227,7 @@ HeadFitOptions defaultHeadFitOptions() {
     for (int k = 17; k < 36; ++k) o.frontLandmarks.push_back(k);
     for (const int k : {36, 39, 42, 45}) o.frontLandmarks.push_back(k);
     for (int k = 48; k < 60; ++k) o.frontLandmarks.push_back(k);
+    o.frontLandmarksByHeight = {18, 19, 20, 23, 24, 25, 49, 50, 52, 53, 55, 56, 58, 59};
     return o;
 }
 
@@ -359,7 +362,6 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
 
         // --- Steps 3-4: targets for the feature and contour vertices.
         const std::vector<glm::dvec3> scaledNormals = scaled.vertexNormals();
-        const auto addFront = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) { frontT.add(scaled, name, v, target); };
         // Contour points: along the outline's normal only (see ViewTargets::add).
         const auto addFrontContour = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) {
             frontT.add(scaled, name, v, target, &scaledNormals);
@@ -367,9 +369,14 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         const auto addSideContour = [&](const std::string& name, std::uint32_t v, const glm::dvec2& target) {
             sideT.add(scaled, name, v, target, &scaledNormals);
         };
+        // Without a modifier basis nothing else shapes the head there: every point pulls both ways, as in the paper.
+        const std::set<int> byHeight = base.modifiers ? std::set<int>(options.frontLandmarksByHeight.begin(),
+                                                                       options.frontLandmarksByHeight.end())
+                                                      : std::set<int>{};
         for (const int k : options.frontLandmarks) {
             const std::string name = landmarkName(k);
-            addFront(name, base.frontFeatures.at(name), fit.front.toHead(fp.at(name)));
+            frontT.addAcross(scaled, name, base.frontFeatures.at(name), fit.front.toHead(fp.at(name)),
+                             byHeight.count(k) ? glm::dvec2(0.0, 1.0) : glm::dvec2(0.0));
         }
         // Below the eye line the silhouette can run on into hair, a collar or the shoulders. dlib's jaw line (points
         // 0..16, a little inside the true outline: it follows the cheek) says where the face's own outline must be; a

@@ -29,6 +29,13 @@ struct HeadFitOptions {
     RbfOptions rbf;
     // Which front landmarks pull the head (default: see defaultHeadFitOptions()).
     std::vector<int> frontLandmarks;
+    // Of those, the points between a brow's ends and between a lip's corners and its middle: where along the line
+    // the detector puts them is its convention (dlib's middle brow points lie up to 4.6 mm nearer the nose than the
+    // base head's feature vertices on the synthetic people, the lips' up to 2.6 mm off along the lip); their height
+    // is what the photo measures. They are fitted in height with full weight, sideways with outlineTangentWeight,
+    // and the warp moves them in height only (with a modifier basis; without one they pull both ways, as in the
+    // paper). Ground-truth landmarks, which are exact, take none.
+    std::vector<int> frontLandmarksByHeight;
     // Accepted ratio between the two photos' scales before they are called a mismatch.
     double maxScaleRatio = 1.35;
     // The first step, with a base head that has a modifier basis: the weights' fit, and how many times it is done
@@ -39,7 +46,8 @@ struct HeadFitOptions {
     double contourWeight = 0.3;
     // A profile landmark on a smooth stretch of outline (chin, brow, lips, ...) is measured along the outline's
     // normal with full weight and along the outline with this weight in the modifier fit: the detector's idea of
-    // where along the curve the point lies is a convention, but not worthless (the ground truth's too).
+    // where along the curve the point lies is a convention, but not worthless (the ground truth's too). The same
+    // weight holds the front's points measured by their height (frontLandmarksByHeight) sideways.
     double outlineTangentWeight = 0.3;
     // Ridge of the warp for the landmarks (added to rbf.regularisation on their diagonal; the outline rays keep the
     // exact interpolation) when the base head has a modifier basis: a detected landmark is a few pixels off, and the
