@@ -22,7 +22,7 @@ void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, con
     };
     double browY = at(17).y;
     for (int k = 18; k <= 26; ++k) browY = std::min(browY, at(k).y);
-    const double sideZ = 0.5 * (at(0).z + at(16).z) + clearance.aheadOfJaw;
+    const double sideZ = 0.5 * (at(0).z + at(16).z);
     for (glm::dvec3& p : hair.positions) {
         if (p.z <= sideZ) continue;
         // 0 from `ramp` over the brows up, 1 from the brows down, smooth between (no crease in a strand).

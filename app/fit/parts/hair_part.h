@@ -22,9 +22,8 @@ const HeadProxy* findHairProxy(const BaseHead& base, HairStyle style);
 
 // How far hair keeps off the face (keepFaceClear), in millimetres.
 struct FaceClearance {
-    double aheadOfJaw = 0.0;  // hair under the brows stays behind the plane this far ahead of the jaw's top (ibug 0, 16)
-    double depth = 10.0;      // what was ahead of that plane keeps within this depth of it
-    double ramp = 15.0;       // over the brows, the push fades out over this height
+    double depth = 10.0;  // under the brows, what was ahead of the plane through the jaw's top keeps within this of it
+    double ramp = 15.0;   // over the brows, the push fades out over this height
 };
 
 // Moves the hair that would hang in front of the face the photo shows. MakeHuman's styles are made for its default
