@@ -9,12 +9,12 @@
 // written: no fold anywhere, no failure with ground-truth landmarks, few with detected ones, and the medians.
 #include "face_shape_error.h"
 #include "test_paths.h"
+#include "truth_measurements.h"
 
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/image_io.h"
 #include "common/landmark_names.h"
-#include "fit/face/silhouette.h"
 #include "fit/fit_pipeline.h"
 #include "fit/head/folds.h"
 #include "fit/head/makehuman_import.h"
@@ -242,12 +242,7 @@ TEST(MakeHumanPopulation, FitsEveryPersonWithoutFoldsAndWithinTheMeasuredShapeEr
         // (a) The ground-truth landmarks, silhouettes from the photos against the empty booth.
         Result truth;
         try {
-            PhotoMeasurements m;
-            m.frontPoints = v.frontLandmarks;
-            m.sidePoints = v.sideLandmarks;
-            m.frontMask = segmentPerson(v.front, v.background);
-            m.sideMask = segmentPerson(v.side, v.background);
-            m.sideNoseImageRight = options.sideNoseImageRight;
+            const PhotoMeasurements m = test::truthMeasurements(v, options.sideNoseImageRight);
             // Exact points: each is measured both ways (HeadFitOptions::frontLandmarksByHeight).
             HeadFitOptions exact = pipeline.settings().head;
             exact.frontLandmarksByHeight.clear();
@@ -348,12 +343,7 @@ TEST(MakeHumanPopulation, ASidewaysShiftOfTheMiddleBrowPointsLeavesTheBrowsWhere
     options.seed = 7;
     const MakeHumanVisitor person = makeMakeHumanVisitor(*base, renderer, options);
     const SyntheticVisitor& v = person.photos;
-    PhotoMeasurements m;
-    m.frontPoints = v.frontLandmarks;
-    m.sidePoints = v.sideLandmarks;
-    m.frontMask = segmentPerson(v.front, v.background);
-    m.sideMask = segmentPerson(v.side, v.background);
-    m.sideNoseImageRight = options.sideNoseImageRight;
+    const PhotoMeasurements m = test::truthMeasurements(v, options.sideNoseImageRight);
     PhotoMeasurements shifted = m;
     // Towards the nose: the person's right brow (18-20) is on the photo's left.
     const double px = 5.0 / options.mmPerPixel;

@@ -1,6 +1,7 @@
 // The texture step on the synthetic visitor, whose painted texture is known: photographed without shading, the
 // head fitted from its true landmarks and textured from the two photos must give back the paint where they see it.
-#include "fit/face/silhouette.h"
+#include "truth_measurements.h"
+
 #include "fit/head/head_fit.h"
 #include "fit/head/photo_texture.h"
 #include "fit/head/surface_texels.h"
@@ -51,12 +52,7 @@ TEST(PhotoTextureSynthetic, TextureMatchesThePaintWhereThePhotosSeeIt) {
         o.sideNoseImageRight = seed % 2 == 1;
         o.lit = false;  // the photos show the paint itself, so the texture can be compared with it
         const SyntheticVisitor v = makeSyntheticVisitor(base, renderer(), o);
-        PhotoMeasurements m;
-        m.frontPoints = v.frontLandmarks;
-        m.sidePoints = v.sideLandmarks;
-        m.frontMask = segmentPerson(v.front, v.background);
-        m.sideMask = segmentPerson(v.side, v.background);
-        m.sideNoseImageRight = o.sideNoseImageRight;
+        const PhotoMeasurements m = test::truthMeasurements(v, o.sideNoseImageRight);
         const HeadFit fit = fitHead(base, m, defaultHeadFitOptions());
         PhotoTextureOptions to;
         to.size = o.textureSize;

@@ -1,7 +1,8 @@
 // Fitting the synthetic visitor, whose true shape is known: with ground-truth landmarks the fitted head must be
 // within 1 % of head height (RMS over the head's vertices, after a similarity alignment).
+#include "truth_measurements.h"
+
 #include "fit/face/landmarks68.h"
-#include "fit/face/silhouette.h"
 #include "fit/fit_pipeline.h"
 #include "fit/head/head_fit.h"
 #include "fit/head/shape_compare.h"
@@ -29,16 +30,6 @@ double headHeight(const BaseHead& base, const Mesh& mesh) {
     return mesh.positions[base.sideFeatures.at("top_of_head")].y - mesh.positions[base.frontFeatures.at("ibug_08")].y;
 }
 
-PhotoMeasurements truthMeasurements(const SyntheticVisitor& v, bool noseRight) {
-    PhotoMeasurements m;
-    m.frontPoints = v.frontLandmarks;
-    m.sidePoints = v.sideLandmarks;
-    m.frontMask = segmentPerson(v.front, v.background);
-    m.sideMask = segmentPerson(v.side, v.background);
-    m.sideNoseImageRight = noseRight;
-    return m;
-}
-
 }  // namespace
 
 class SyntheticFit : public ::testing::TestWithParam<unsigned> {};
@@ -50,7 +41,7 @@ TEST_P(SyntheticFit, GroundTruthLandmarksRecoverTheShapeWithinOnePercent) {
     o.sideNoseImageRight = GetParam() % 2 == 1;
     o.textureSize = 256;  // the paint does not matter here
     const SyntheticVisitor v = makeSyntheticVisitor(base, renderer(), o);
-    const HeadFit fit = fitHead(base, truthMeasurements(v, o.sideNoseImageRight), defaultHeadFitOptions());
+    const HeadFit fit = fitHead(base, test::truthMeasurements(v, o.sideNoseImageRight), defaultHeadFitOptions());
 
     const double height = headHeight(base, v.truthMesh);
     const double before = rmsAfterSimilarity(base.mesh, v.truthMesh, headRegion(base));

@@ -19,6 +19,8 @@ struct Mesh {
     std::vector<glm::dvec3> vertexNormals() const;
     // Axis-aligned bounds of the positions.
     void bounds(glm::dvec3& lo, glm::dvec3& hi) const;
+    // The front-most z of the surface over (x, y), seen along z, or NaN where that line misses it.
+    double frontZ(double x, double y) const;
 };
 
 }  // namespace avatarbooth

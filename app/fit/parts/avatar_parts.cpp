@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace avatarbooth {
 
@@ -59,30 +58,6 @@ cv::Mat tintTexture(const cv::Mat& texture, const cv::Mat& mask, const cv::Vec3d
     return out;
 }
 
-namespace {
-
-// The front-most z of `head` over (x, y), or NaN where the line along z misses it.
-double frontZ(const Mesh& head, double x, double y) {
-    double best = std::numeric_limits<double>::quiet_NaN();
-    for (const auto& t : head.triangles) {
-        const glm::dvec3 &a = head.positions[t.x], &b = head.positions[t.y], &c = head.positions[t.z];
-        if (x < std::min({a.x, b.x, c.x}) || x > std::max({a.x, b.x, c.x}) || y < std::min({a.y, b.y, c.y}) ||
-            y > std::max({a.y, b.y, c.y}))
-            continue;
-        const double det = (b.y - c.y) * (a.x - c.x) + (c.x - b.x) * (a.y - c.y);
-        if (std::abs(det) < 1e-12) continue;
-        const double l0 = ((b.y - c.y) * (x - c.x) + (c.x - b.x) * (y - c.y)) / det;
-        const double l1 = ((c.y - a.y) * (x - c.x) + (a.x - c.x) * (y - c.y)) / det;
-        const double l2 = 1.0 - l0 - l1;
-        if (l0 < 0 || l1 < 0 || l2 < 0) continue;
-        const double z = l0 * a.z + l1 * b.z + l2 * c.z;
-        if (!(z <= best)) best = z;
-    }
-    return best;
-}
-
-}  // namespace
-
 void alignToPoints(AvatarPart& part, const Mesh& head, const std::vector<glm::dvec2>& points, double below) {
     for (const double side : {-1.0, 1.0}) {
         double shift = 0.0;
@@ -101,7 +76,7 @@ void alignToPoints(AvatarPart& part, const Mesh& head, const std::vector<glm::dv
         shift /= count;
         for (auto& p : part.mesh.positions) {
             if (p.x * side <= 0) continue;
-            const double from = frontZ(head, p.x, p.y), to = frontZ(head, p.x, p.y + shift);
+            const double from = head.frontZ(p.x, p.y), to = head.frontZ(p.x, p.y + shift);
             p.y += shift;
             if (std::isfinite(from) && std::isfinite(to)) p.z += to - from;
         }
