@@ -457,10 +457,10 @@ MakeHumanVisitor makeMakeHumanVisitor(const BaseHead& mh, MeshRenderer& renderer
     if (const auto style = hairStyleFromString(person.hairStyle); !options.hairProxies) {
         if (person.hairStyle != "none") person.hairStyle = "short";
     } else if (style && *style != HairStyle::None) {
-        HairEstimate hair;
-        hair.style = *style;
-        hair.colour = person.hairColour;
-        if (auto part = placeHairPart(mh, v.truthMesh, hair)) setup.parts.push_back(std::move(*part));
+        // Short hair is short02, fuller than the avatar's crop (short04): visitors' short hair stands off the scalp,
+        // and the painted people without proxies are the crops.
+        const char* proxy = *style == HairStyle::Short ? "short02" : hairProxyName(*style);
+        if (auto part = placeHairPart(mh, v.truthMesh, proxy, person.hairColour)) setup.parts.push_back(std::move(*part));
         else person.hairStyle = "short";
     }
     photographSyntheticHead(v, mh, earHoleOf(mh, v.truthMesh), renderer, setup);

@@ -38,7 +38,7 @@ void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, con
 const char* hairProxyName(HairStyle style) {
     switch (style) {
         case HairStyle::None: return nullptr;
-        case HairStyle::Short: return "short02";
+        case HairStyle::Short: return "short04";
         case HairStyle::Bob: return "bob02";
         case HairStyle::Long: return "long01";
         case HairStyle::Ponytail: return "ponytail01";
@@ -48,19 +48,23 @@ const char* hairProxyName(HairStyle style) {
 
 bool isHairStyleProxy(const HeadProxy& proxy) { return proxy.name == "hair"; }
 
-const HeadProxy* findHairProxy(const BaseHead& base, HairStyle style) {
-    const char* name = hairProxyName(style);
-    if (name == nullptr) return nullptr;
-    const std::string source = std::string("proxies/hair/") + name;
+const HeadProxy* findHairProxy(const BaseHead& base, std::string_view proxyName) {
+    const std::string source = "proxies/hair/" + std::string(proxyName);
     for (const HeadProxy& p : base.proxies)
         if (isHairStyleProxy(p) && p.source == source) return &p;
     return nullptr;
 }
 
 std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fittedHead, const HairEstimate& hair) {
-    const HeadProxy* proxy = findHairProxy(base, hair.style);
+    const char* name = hairProxyName(hair.style);
+    return name == nullptr ? std::nullopt : placeHairPart(base, fittedHead, name, hair.colour);
+}
+
+std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fittedHead, std::string_view proxyName,
+                                        const cv::Vec3d& colour) {
+    const HeadProxy* proxy = findHairProxy(base, proxyName);
     if (proxy == nullptr) return std::nullopt;
-    std::optional<AvatarPart> part = placeProxyPart(*proxy, fittedHead, &hair.colour);
+    std::optional<AvatarPart> part = placeProxyPart(*proxy, fittedHead, &colour);
     // The avatar is a bust cut under the chin: long hair ends where the neck does, not in the air at waist height
     // (which also made every preview frame a head a third of its size).
     if (part) {

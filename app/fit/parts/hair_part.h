@@ -8,17 +8,21 @@
 #include "fit/parts/head_proxy.h"
 
 #include <optional>
+#include <string_view>
 
 namespace avatarbooth {
 
-// The MakeHuman proxy that wears a style ("short02", "bob02", "long01", "ponytail01"; none for HairStyle::None).
+// The MakeHuman proxy the avatar wears for a style ("short04", "bob02", "long01", "ponytail01"; none for
+// HairStyle::None). Short hair is short04, a crop within 2 mm of the scalp: with short hair the head fit follows the
+// photos' outline, hair included, so the part must add no volume of its own (short02 stands 14 mm off the scalp; over
+// the fitted heads of FRMDB 002 and 003 it made a mushroom, README "Hair").
 const char* hairProxyName(HairStyle style);
 
 // A proxy that is one of the hair styles (named "hair"): an alternative, placed only when chosen.
 bool isHairStyleProxy(const HeadProxy& proxy);
 
-// The style's proxy among base.proxies (its source "proxies/hair/NAME"), or null when the base head has none.
-const HeadProxy* findHairProxy(const BaseHead& base, HairStyle style);
+// The hair proxy of that name among base.proxies (its source "proxies/hair/NAME"), or null when the base head has none.
+const HeadProxy* findHairProxy(const BaseHead& base, std::string_view proxyName);
 
 // How far hair keeps off the face (keepFaceClear), in millimetres.
 struct FaceClearance {
@@ -38,5 +42,8 @@ void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, con
 // The hair part on `fittedHead` (the base head's topology), its strands in the estimate's colour; nothing when the
 // estimate says bald or the base head has no proxy for the style.
 std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fittedHead, const HairEstimate& hair);
+// Likewise for a named proxy of the base head (the synthetic visitors wear proxies the avatar does not).
+std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fittedHead, std::string_view proxyName,
+                                        const cv::Vec3d& colour);
 
 }  // namespace avatarbooth
