@@ -31,9 +31,10 @@ struct MakeHumanImportOptions {
     std::string eyes = "HighPolyEyes";      // replaces hm08's eyeballs; its iris tinted from the photo
     std::string eyebrows = "eyebrow001";    // tinted from the photo
     std::string eyelashes = "Eyelashes01";
-    // The hair styles the fit chooses among (fit/parts/hair_part.h), each a part named "hair" (its source names it),
-    // all by Manuel Bastioni, short02 with Jonas Hauquier (proxies/hair/NAME/NAME.json's metadata). The beard and moustache proxies of the package
-    // are by a contributor (grinsegold), not the MakeHuman team, and are left out.
+    // The hair styles the fit chooses among (fit/parts/hair_part.h) and short02, which the synthetic visitors wear;
+    // each a part named "hair" (its source names it), all by Manuel Bastioni, short02 with Jonas Hauquier
+    // (proxies/hair/NAME/NAME.json's metadata). The beard and moustache proxies of the package are by a contributor
+    // (grinsegold), not the MakeHuman team, and are left out.
     std::vector<std::string> hair = {"short02", "short04", "bob02", "long01", "ponytail01"};
     // The iris texture tinted with the photo's colour (eyes/NAME/textures/IRIS_eye.png).
     std::string iris = "brownlight";
