@@ -1,6 +1,6 @@
 // All eight FRMDB people (real photos, dark hair on a dark backdrop) fit without error, with both profile
 // directions, with the product's base head (MakeHuman's) and without a fold; the overlays and previews are written
-// for a person to look at.
+// for a person to look at, with the avatar's outline over the photo's (silhouette_front.jpg, silhouette_side.jpg).
 #include "test_paths.h"
 
 #include "fit/export/glb.h"
@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -36,8 +37,8 @@ MeshRenderer& renderer() {
 
 // How well the avatar's silhouette (the head and its hair) covers the photo's above the brows, where the hair is:
 // intersection over union of the two, the avatar drawn into the photo through the fit's frame (front: x, y; side:
-// z, y).
-double silhouetteAgreementAboveBrows(const FitOutcome& o, bool side) {
+// z, y). Both outlines are drawn on the photo into `overlay`.
+double silhouetteAgreementAboveBrows(const FitOutcome& o, bool side, const fs::path& overlay) {
     const PhotoFrame& frame = side ? o.fit.side : o.fit.front;
     const cv::Mat& photo = side ? o.sideMask : o.frontMask;
     cv::Mat avatar = cv::Mat::zeros(photo.size(), CV_8U);
@@ -59,6 +60,15 @@ double silhouetteAgreementAboveBrows(const FitOutcome& o, bool side) {
     for (int k = 17; k <= 26; ++k)
         browY = std::max(browY, o.fit.mesh.positions[pipeline().baseHead().frontFeatures.at(landmarkName(k))].y);
     const cv::Rect above(0, 0, photo.cols, std::clamp(cvRound(frame.toPixel({0.0, browY}).y), 1, photo.rows));
+    // For a person to look at: the photo's outline (cyan), the avatar's (red), the brows' height (green).
+    cv::Mat drawn = (side ? o.side : o.front).clone();
+    for (const auto& [mask, colour] : {std::pair{photo, cv::Scalar(255, 255, 0)}, std::pair{avatar, cv::Scalar(0, 0, 255)}}) {
+        std::vector<std::vector<cv::Point>> outline;
+        cv::findContours(mask.clone(), outline, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+        cv::drawContours(drawn, outline, -1, colour, 2, cv::LINE_AA);
+    }
+    cv::line(drawn, {0, above.height}, {drawn.cols, above.height}, cv::Scalar(0, 255, 0), 1);
+    cv::imwrite(overlay.string(), drawn);
     const double both = cv::countNonZero(avatar(above) & photo(above));
     const double either = cv::countNonZero(avatar(above) | photo(above));
     return both / std::max(1.0, either);
@@ -115,8 +125,8 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
     // The avatar's outline above the brows is the photos': with short hair the head fit follows the outline, so the
     // hair part must add no volume (short02 over the fitted heads of 002 and 003: 0.74-0.81; short04 0.91-0.95).
     // Big hair is a proxy of its own shape (0.67-0.84 when this was written; 008's curls are wider than the bob).
-    const double frontAgreement = silhouetteAgreementAboveBrows(outcome, false);
-    const double sideAgreement = silhouetteAgreementAboveBrows(outcome, true);
+    const double frontAgreement = silhouetteAgreementAboveBrows(outcome, false, out.parent_path() / "silhouette_front.jpg");
+    const double sideAgreement = silhouetteAgreementAboveBrows(outcome, true, out.parent_path() / "silhouette_side.jpg");
     std::printf("%s %s: %s hair; the avatar's silhouette over the photo's above the brows (IoU): front %.3f, side %.3f\n",
                 person, std::get<1>(GetParam()), toString(outcome.hair.style), frontAgreement, sideAgreement);
     const double floor = outcome.hair.style == HairStyle::Short ? 0.85 : 0.6;
