@@ -217,6 +217,13 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     out.partColours = measurePartColours(front, out.frontLandmarks);
     out.parts = placeParts(base_, out.fit.mesh, out.texture.texture, out.partColours);
     if (auto hair = placeHairPart(base_, out.fit.mesh, out.hair)) {
+        // Big hair is as full as the photos show it (short hair is in the head's own outline already).
+        if (isBigHair(out.hair.style)) {
+            HairSilhouetteFit follow;
+            follow.behind = out.hair.style != HairStyle::Ponytail;
+            fitHairToSilhouettes(hair->mesh, out.fit.mesh, out.fit.front, out.frontMask, out.fit.side, out.sideMask,
+                                 out.fit.mesh.positions[base_.frontFeatures.at(landmarkName(8))].y, follow);
+        }
         // The photo showed the face (its landmarks were all found): the avatar's hair leaves it clear too.
         keepFaceClear(hair->mesh, base_, out.fit.mesh);
         out.parts.push_back(std::move(*hair));

@@ -124,12 +124,13 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
     }
     // The avatar's outline above the brows is the photos': with short hair the head fit follows the outline, so the
     // hair part must add no volume (short02 over the fitted heads of 002 and 003: 0.74-0.81; short04 0.91-0.95).
-    // Big hair is a proxy of its own shape (0.67-0.84 when this was written; 008's curls are wider than the bob).
+    // Big hair follows the photos' outlines beside and behind the head (fitHairToSilhouettes: 0.77-0.89, the proxies
+    // as they come 0.67-0.84; 008's curls are fuller than the bob, 005's hair falls to one side).
     const double frontAgreement = silhouetteAgreementAboveBrows(outcome, false, out.parent_path() / "silhouette_front.jpg");
     const double sideAgreement = silhouetteAgreementAboveBrows(outcome, true, out.parent_path() / "silhouette_side.jpg");
     std::printf("%s %s: %s hair; the avatar's silhouette over the photo's above the brows (IoU): front %.3f, side %.3f\n",
                 person, std::get<1>(GetParam()), toString(outcome.hair.style), frontAgreement, sideAgreement);
-    const double floor = outcome.hair.style == HairStyle::Short ? 0.85 : 0.6;
+    const double floor = outcome.hair.style == HairStyle::Short ? 0.85 : 0.75;
     EXPECT_GT(frontAgreement, floor);
     EXPECT_GT(sideAgreement, floor);
     std::printf("%s %s: parts", person, std::get<1>(GetParam()));

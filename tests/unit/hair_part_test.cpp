@@ -1,6 +1,6 @@
-// The hair part keeps the face clear (fit/parts/hair_part.h): hair under the brows and ahead of the plane through the
-// jaw's top goes back to within FaceClearance::depth of it, keeping its order; over the brows it fades out; nothing
-// else moves.
+// The hair part (fit/parts/hair_part.h). It keeps the face clear: hair under the brows and ahead of the plane through
+// the jaw's top goes back to within FaceClearance::depth of it, keeping its order; over the brows it fades out; nothing
+// else moves. Big hair meets the photos' outlines beside and behind the head, and nothing within the head's moves.
 #include "fit/parts/hair_part.h"
 
 #include "common/error.h"
@@ -8,7 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
+
+#include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 using namespace avatarbooth;
 
@@ -80,4 +85,73 @@ TEST(HairPart, AHeadWithoutTheFeatureVerticesIsAnInternalError) {
         EXPECT_EQ(e.kind(), ErrorKind::Internal);
         EXPECT_NE(std::string(e.what()).find("ibug_16"), std::string::npos) << e.what();
     }
+}
+
+namespace {
+
+// The four side walls of a box (x from xMinus to xPlus, z from zBack to zFront) through rings of vertices at the given
+// heights, as triangles: what the silhouette fit slices.
+Mesh walls(double xMinus, double xPlus, double zBack, double zFront, const std::vector<double>& rings) {
+    Mesh m;
+    for (const double y : rings)
+        for (const auto& [x, z] : {std::pair{xMinus, zBack}, std::pair{xPlus, zBack}, std::pair{xPlus, zFront}, std::pair{xMinus, zFront}})
+            m.positions.emplace_back(x, y, z);
+    for (std::uint32_t r = 0; r + 1 < rings.size(); ++r)
+        for (std::uint32_t c = 0; c < 4; ++c) {
+            const std::uint32_t a = 4 * r + c, b = 4 * r + (c + 1) % 4;
+            m.triangles.emplace_back(a, b, b + 4);
+            m.triangles.emplace_back(a, b + 4, a + 4);
+        }
+    return m;
+}
+
+// A photo frame at 1 mm per pixel with the head's origin at pixel (200, 200), and a mask filled over [from, to] in
+// the frame's horizontal coordinate, for every row.
+PhotoFrame frame() {
+    PhotoFrame f;
+    f.centrePx = {200.0, 200.0};
+    f.imageWidth = 400;
+    return f;
+}
+
+cv::Mat mask(double from, double to) {
+    cv::Mat m = cv::Mat::zeros(400, 400, CV_8U);
+    m.colRange(static_cast<int>(from) + 200, static_cast<int>(to) + 201).setTo(255);
+    return m;
+}
+
+}  // namespace
+
+TEST(HairPart, BigHairMeetsThePhotosOutlineBesideAndBehindTheHead) {
+    // The head a box 120 mm wide and 160 deep; the hair 30 mm out to each side and behind it, down to the chin (y
+    // -100). The photos: the hair reaches 15 mm out on the +x side, 60 on the -x side, 15 behind.
+    const Mesh head = walls(-60.0, 60.0, -80.0, 80.0, {-100.0, 100.0});
+    Mesh hair = walls(-90.0, 90.0, -110.0, 50.0, {-100.0, 0.0, 50.0});
+    const auto stretches = fitHairToSilhouettes(hair, head, frame(), mask(-120.0, 75.0), frame(), mask(-95.0, 90.0), -100.0);
+    for (std::size_t i = 4; i < 8; ++i) {  // the ring at y 0
+        const glm::dvec3& p = hair.positions[i];
+        EXPECT_NEAR(std::abs(p.x), p.x > 0 ? 75.0 : 120.0, 1e-6) << i;
+        EXPECT_NEAR(p.z, p.z < 0 ? -95.0 : 50.0, 1e-6) << i;  // the front (z 50, inside the head's depth) stays
+        EXPECT_EQ(p.y, 0.0);
+    }
+    // The stretches the bands report: (75 - 60) / 30, (120 - 60) / 30, (95 - 80) / 30.
+    const auto at = std::find_if(stretches.begin(), stretches.end(), [](const HairStretch& s) { return s.y > 0.0; });
+    ASSERT_NE(at, stretches.end());
+    EXPECT_NEAR(at->plusX, 0.5, 1e-9);
+    EXPECT_NEAR(at->minusX, 2.0, 1e-9);
+    EXPECT_NEAR(at->back, 0.5, 1e-9);
+}
+
+TEST(HairPart, HairWithinTheHeadsOutlineAndAPonytailsBackStayPut) {
+    const Mesh head = walls(-60.0, 60.0, -80.0, 80.0, {-100.0, 100.0});
+    // A cap inside the head's width and depth, and a tail 40 mm behind the head.
+    Mesh cap = walls(-50.0, 50.0, -70.0, 40.0, {-50.0, 0.0, 50.0});
+    const Mesh capBefore = cap;
+    fitHairToSilhouettes(cap, head, frame(), mask(-100.0, 100.0), frame(), mask(-100.0, 90.0), -100.0);
+    EXPECT_EQ(cap.positions, capBefore.positions);
+    Mesh tail = walls(-20.0, 20.0, -120.0, -90.0, {-100.0, 0.0, 50.0});
+    HairSilhouetteFit options;
+    options.behind = false;
+    fitHairToSilhouettes(tail, head, frame(), mask(-100.0, 100.0), frame(), mask(-90.0, 90.0), -100.0, options);
+    for (const glm::dvec3& p : tail.positions) EXPECT_TRUE(p.z == -120.0 || p.z == -90.0) << p.z;
 }

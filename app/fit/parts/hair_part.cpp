@@ -5,9 +5,15 @@
 #include "common/landmark_names.h"
 #include "fit/parts/avatar_parts.h"
 
+#include <opencv2/core.hpp>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -33,6 +39,150 @@ void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, con
         const double kept = clearance.depth * (1.0 - std::exp(-ahead / clearance.depth));
         p.z -= t * t * (3.0 - 2.0 * t) * (ahead - kept);
     }
+}
+
+namespace {
+
+// The run of mask pixels along `row` that holds column `through` (or the nearest run to it), as [first, last]
+// columns; nothing when the row is empty or outside the mask.
+std::optional<std::pair<int, int>> runThrough(const cv::Mat& mask, int row, int through) {
+    if (row < 0 || row >= mask.rows) return std::nullopt;
+    const auto* m = mask.ptr<std::uint8_t>(row);
+    through = std::clamp(through, 0, mask.cols - 1);
+    int at = -1;
+    for (int d = 0; d < mask.cols && at < 0; ++d) {
+        if (through - d >= 0 && m[through - d]) at = through - d;
+        else if (through + d < mask.cols && m[through + d]) at = through + d;
+    }
+    if (at < 0) return std::nullopt;
+    int first = at, last = at;
+    while (first > 0 && m[first - 1]) --first;
+    while (last + 1 < mask.cols && m[last + 1]) ++last;
+    return std::pair{first, last};
+}
+
+// Where a mesh crosses the plane at height y, its extreme +x, -x and -z (NaN when it does not cross it).
+std::array<double, 3> sliceExtent(const Mesh& mesh, double y) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    std::array<double, 3> e{nan, nan, nan};
+    const auto add = [&](const glm::dvec3& p) {
+        if (std::isnan(e[0])) e = {p.x, p.x, p.z};
+        else e = {std::max(e[0], p.x), std::min(e[1], p.x), std::min(e[2], p.z)};
+    };
+    for (const glm::uvec3& t : mesh.triangles)
+        for (int i = 0; i < 3; ++i) {
+            const glm::dvec3& a = mesh.positions[t[i]];
+            const glm::dvec3& b = mesh.positions[t[(i + 1) % 3]];
+            if ((a.y - y) * (b.y - y) > 0.0 || a.y == b.y) continue;
+            add(a + (b - a) * ((y - a.y) / (b.y - a.y)));
+        }
+    return e;
+}
+
+// The stretch that takes hair reaching `avatar` beyond a head edge at `head` to `photo` (all along one direction,
+// outwards positive); NaN where the hair does not stand out.
+double stretchTo(double head, double avatar, double photo, const HairSilhouetteFit& o) {
+    if (!(avatar - head > o.stands)) return std::numeric_limits<double>::quiet_NaN();
+    return std::clamp((photo - head) / (avatar - head), o.minStretch, o.maxStretch);
+}
+
+}  // namespace
+
+std::vector<HairStretch> fitHairToSilhouettes(Mesh& hair, const Mesh& fittedHead, const PhotoFrame& front,
+                                              const cv::Mat& frontMask, const PhotoFrame& side, const cv::Mat& sideMask,
+                                              double chinY, const HairSilhouetteFit& o) {
+    if (frontMask.empty() || sideMask.empty() || frontMask.type() != CV_8U || sideMask.type() != CV_8U)
+        throw BoothError(ErrorKind::Internal, "hair part", "fitting the hair to the silhouettes needs both 8-bit masks");
+    glm::dvec3 lo, hi;
+    fittedHead.bounds(lo, hi);
+    double top = hi.y;
+    for (const glm::dvec3& p : hair.positions) top = std::max(top, p.y);
+    const int bands = std::max(1, static_cast<int>(std::ceil((top - chinY) / o.band)));
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    // Per band: the head's edges (+x, -x, back), the avatar's (head and hair), the stretches.
+    struct Band {
+        double headPlus = -1e9, headMinus = 1e9, headBack = 1e9;
+        double plus = -1e9, minus = 1e9, back = 1e9;
+        double k[3] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                       std::numeric_limits<double>::quiet_NaN()};
+    };
+    std::vector<Band> b(static_cast<std::size_t>(bands));
+    for (int i = 0; i < bands; ++i) {
+        Band& x = b[static_cast<std::size_t>(i)];
+        const double y = chinY + (i + 0.5) * o.band;
+        const auto head = sliceExtent(fittedHead, y), strands = sliceExtent(hair, y);
+        if (!std::isnan(head[0])) x.headPlus = head[0], x.headMinus = head[1], x.headBack = head[2];
+        x.plus = x.headPlus, x.minus = x.headMinus, x.back = x.headBack;
+        if (!std::isnan(strands[0]))
+            x.plus = std::max(x.plus, strands[0]), x.minus = std::min(x.minus, strands[1]), x.back = std::min(x.back, strands[2]);
+    }
+    const double midZ = 0.5 * (lo.z + hi.z);
+    for (int i = 0; i < bands; ++i) {
+        Band& x = b[static_cast<std::size_t>(i)];
+        if (x.headPlus < x.headMinus) continue;  // no head vertex at this height (over the skull: the hair's crown)
+        const double y = chinY + (i + 0.5) * o.band;
+        const cv::Point2d f = front.toPixel({0.0, y});
+        if (const auto run = runThrough(frontMask, static_cast<int>(std::lround(f.y)), static_cast<int>(std::lround(f.x)))) {
+            double a = front.toHead({static_cast<double>(run->first), f.y}).x, c = front.toHead({static_cast<double>(run->second), f.y}).x;
+            if (a > c) std::swap(a, c);
+            x.k[0] = stretchTo(x.headPlus, x.plus, c, o);
+            x.k[1] = stretchTo(-x.headMinus, -x.minus, -a, o);
+        }
+        const cv::Point2d s = side.toPixel({midZ, y});
+        if (!o.behind) continue;
+        if (const auto run = runThrough(sideMask, static_cast<int>(std::lround(s.y)), static_cast<int>(std::lround(s.x)))) {
+            const double a = side.toHead({static_cast<double>(run->first), s.y}).x, c = side.toHead({static_cast<double>(run->second), s.y}).x;
+            x.k[2] = stretchTo(-x.headBack, -x.back, -std::min(a, c), o);
+        }
+    }
+    // Smoothed along the height (a Gaussian over the bands that measured a stretch), and the head's edges with it.
+    const double sigma = o.smooth / o.band;
+    const int reach = static_cast<int>(std::ceil(3.0 * sigma));
+    std::vector<HairStretch> out(static_cast<std::size_t>(bands));
+    std::vector<std::array<double, 3>> edge(static_cast<std::size_t>(bands));
+    for (int i = 0; i < bands; ++i) {
+        std::array<double, 3> k{}, kw{}, e{}, ew{};
+        for (int j = std::max(0, i - reach); j <= std::min(bands - 1, i + reach); ++j) {
+            const Band& x = b[static_cast<std::size_t>(j)];
+            const double w = std::exp(-0.5 * (j - i) * (j - i) / (sigma * sigma));
+            const double edges[3] = {x.headPlus, -x.headMinus, -x.headBack};
+            for (int c = 0; c < 3; ++c) {
+                if (!std::isnan(x.k[c])) k[c] += w * x.k[c], kw[c] += w;
+                if (x.headPlus >= x.headMinus) e[c] += w * edges[c], ew[c] += w;
+            }
+        }
+        HairStretch& h = out[static_cast<std::size_t>(i)];
+        h.y = chinY + (i + 0.5) * o.band;
+        // Over the skull's top the head's slices shrink to nothing and their edges say little: the stretch fades out
+        // over the top `crown` millimetres of the head (stretched there, the crown's hair sank under the scalp).
+        const double u = std::clamp((hi.y - h.y - o.crown * 0.25) / (o.crown * 0.75), 0.0, 1.0);
+        const double fade = u * u * (3.0 - 2.0 * u);
+        double* ks[3] = {&h.plusX, &h.minusX, &h.back};
+        for (int c = 0; c < 3; ++c) {
+            *ks[c] = 1.0 + fade * ((kw[c] > 1e-6 ? k[c] / kw[c] : 1.0) - 1.0);
+            edge[static_cast<std::size_t>(i)][static_cast<std::size_t>(c)] = ew[c] > 1e-6 ? e[c] / ew[c] : nan;
+        }
+    }
+    // Bands over the head's top have no edge: they keep the top-most edge below them.
+    for (std::size_t i = 1; i < edge.size(); ++i)
+        for (std::size_t c = 0; c < 3; ++c)
+            if (std::isnan(edge[i][c])) edge[i][c] = edge[i - 1][c];
+    for (glm::dvec3& p : hair.positions) {
+        const double t = std::clamp((p.y - chinY) / o.band - 0.5, 0.0, static_cast<double>(bands - 1));
+        const std::size_t i = static_cast<std::size_t>(std::floor(t));
+        const std::size_t j = std::min(i + 1, out.size() - 1);
+        const double f = t - static_cast<double>(i);
+        const auto lerp = [&](double a, double c) { return a + f * (c - a); };
+        const double k[3] = {lerp(out[i].plusX, out[j].plusX), lerp(out[i].minusX, out[j].minusX), lerp(out[i].back, out[j].back)};
+        double e[3];
+        for (std::size_t c = 0; c < 3; ++c) e[c] = lerp(edge[i][c], edge[j][c]);
+        if (std::isnan(e[0])) continue;
+        // Outwards along +x, -x and -z: beyond the head's edge the hair's distance from it is scaled.
+        if (p.x > e[0]) p.x = e[0] + k[0] * (p.x - e[0]);
+        if (-p.x > e[1]) p.x = -(e[1] + k[1] * (-p.x - e[1]));
+        if (-p.z > e[2]) p.z = -(e[2] + k[2] * (-p.z - e[2]));
+    }
+    return out;
 }
 
 const char* hairProxyName(HairStyle style) {

@@ -4,11 +4,13 @@
 
 #include "fit/face/hair_analysis.h"
 #include "fit/head/base_head.h"
+#include "fit/head/head_fit.h"
 #include "fit/parts/avatar_part.h"
 #include "fit/parts/head_proxy.h"
 
 #include <optional>
 #include <string_view>
+#include <vector>
 
 namespace avatarbooth {
 
@@ -38,6 +40,35 @@ struct FaceClearance {
 // photo showed the face); the synthetic visitors wear the proxies as MakeHuman made them, fringes included, which
 // the booth must cope with.
 void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, const FaceClearance& clearance = {});
+
+// How the hair part follows the photos' silhouettes (fitHairToSilhouettes), in millimetres.
+struct HairSilhouetteFit {
+    double band = 2.0;      // the height of one band of the outline
+    double smooth = 8.0;    // the stretch varies along the height with a Gaussian of this deviation
+    double stands = 2.0;    // hair standing out less than this beyond the head is not stretched (nothing to stretch)
+    double minStretch = 0.25, maxStretch = 2.5;
+    double crown = 40.0;    // no stretch within a quarter of this under the head's top, all of it from this down
+    // Whether the hair behind the head follows the side photo's outline too. Not for a ponytail: its knot and tail
+    // are the proxy's own (stretched, the knot sank into the crown's hair and showed as a dark patch, FRMDB 004).
+    bool behind = true;
+};
+
+// How far each band of height was stretched (for fit.json and tests): the band's centre and the stretch of the
+// hair beside the head on the head's +x side, its -x side and behind it; 1 where nothing was measured.
+struct HairStretch {
+    double y = 0.0;
+    double plusX = 1.0, minusX = 1.0, back = 1.0;
+};
+
+// Big hair is a MakeHuman proxy of its own width and depth; the visitor's is fuller or flatter. Band by band of
+// height from the chin to the top, the hair standing out beyond the fitted head to either side (the front photo)
+// and behind it (the side photo) is stretched away from the head so that the avatar's outline meets the photo's;
+// under the chin, where the photos show shoulders, each side keeps the stretch of the chin's height. Each
+// coordinate is mapped monotonically (x' = edge + k (x - edge) beyond the head's edge, k > 0), so the strands keep
+// their order and no triangle turns over. `chinY`: the fitted head's chin. Returns the stretches of the bands.
+std::vector<HairStretch> fitHairToSilhouettes(Mesh& hair, const Mesh& fittedHead, const PhotoFrame& front,
+                                              const cv::Mat& frontMask, const PhotoFrame& side, const cv::Mat& sideMask,
+                                              double chinY, const HairSilhouetteFit& options = {});
 
 // The hair part on `fittedHead` (the base head's topology), its strands in the estimate's colour; nothing when the
 // estimate says bald or the base head has no proxy for the style.
