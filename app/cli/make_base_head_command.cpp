@@ -56,6 +56,7 @@ void registerMakeVisitorCommand(CLI::App& app) {
         SyntheticVisitorOptions visitor;
         bool noseLeft = false;
         bool makehuman = false;
+        bool hair = false;
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("-o,--output", o->out, "Output folder")->required();
@@ -66,6 +67,10 @@ void registerMakeVisitorCommand(CLI::App& app) {
     cmd->add_flag("--makehuman", o->makehuman,
                   "A MakeHuman person (random modifiers, skin, hair, eyes) on the product's base head, instead of the "
                   "warped test head; truth/person.json says who");
+    cmd->add_flag("--hair", o->hair,
+                  "With --makehuman: the person wears the MakeHuman hair proxy of their style (short, bob, long, "
+                  "ponytail) over the painted scalp")
+        ->needs("--makehuman");
     cmd->callback([o] {
         o->visitor.sideNoseImageRight = !o->noseLeft;
         MeshRenderer renderer;
@@ -75,12 +80,13 @@ void registerMakeVisitorCommand(CLI::App& app) {
             MakeHumanVisitorOptions options;
             options.seed = o->visitor.seed;
             options.sideNoseImageRight = o->visitor.sideNoseImageRight;
+            options.hairProxies = o->hair;
             const MakeHumanVisitor visitor = makeMakeHumanVisitor(*base, renderer, options);
             writeMakeHumanVisitorFolder(visitor, *base, dir.staging());
             dir.commit();
             const MakeHumanPerson& p = visitor.person;
             std::cout << "MakeHuman visitor " << options.seed << " (" << p.age << " " << p.ethnicity << " " << p.sex
-                      << ", hair " << p.hair << ", eyes " << p.eyes << ") written to " << o->out << "\n";
+                      << ", hair " << p.hair << " " << p.hairStyle << ", eyes " << p.eyes << ") written to " << o->out << "\n";
             return;
         }
         const SyntheticVisitor visitor = makeSyntheticVisitor(builtinBaseHead(), renderer, o->visitor);
