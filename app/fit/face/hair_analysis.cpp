@@ -242,9 +242,11 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions&
         }
     }
     out.evidence.crown = crownPixels ? static_cast<double>(farPixels) / static_cast<double>(crownPixels) : 0.0;
+    cv::Vec3d crownLabSeen{0.0, 0.0, 0.0};
     if (farPixels >= 20) {
         a.hair = true;
         const cv::Vec3d crownLab{median(hairLab[0]), median(hairLab[1]), median(hairLab[2])};
+        crownLabSeen = crownLab;
         out.evidence.hairFromSkin = labDistance(cv::Vec3f(crownLab), a.skinLab);
 
         // --- The hair's colour: the crown's pixels unlike skin and those beside the face from the head's top to the
@@ -353,6 +355,33 @@ Analysis analyse(const HairPhotos& photos, HairEstimate& out, const HairOptions&
     if (backX == std::numeric_limits<int>::max()) backX = static_cast<int>(ear.x - 100.0 * smm);  // no outline there
     a.behindHead = rectOf(backX - 25.0 * smm, ear.y + 48.0 * smm, backX + 45.0 * smm, ear.y + 70.0 * smm);
     a.downTheBack = rectOf(backX - 30.0 * smm, ear.y + 75.0 * smm, backX + 40.0 * smm, ear.y + 100.0 * smm);
+    if (a.hair) {
+        // The hair's colour from the side photo's crown too (a band 15 mm deep under its outline, 50 mm either side
+        // of the ear hole): its pixels unlike skin, but not those nearer the backdrop's colour (the same columns over
+        // the outline) than the front crown's hair. The side sees the hair in another light than the front's top
+        // light: HairPopulation's colour error dE median 10.2 -> 8.7, worst 24.4 -> 22.1.
+        const std::vector<cv::Rect> band = sideCrown(a.sideMask, ear, smm);
+        std::array<std::vector<double>, 3> off;
+        for (const cv::Rect& r : band)
+            for (int y = std::max(0, r.y - static_cast<int>(20.0 * smm)); y < r.y; ++y) {
+                const cv::Vec3f& l = a.sideLab.at<cv::Vec3f>(y, r.x);
+                for (std::size_t c = 0; c < 3; ++c) off[c].push_back(l[static_cast<int>(c)]);
+            }
+        const bool seen = off[0].size() >= 100;
+        const cv::Vec3d backdrop = seen ? cv::Vec3d{median(off[0]), median(off[1]), median(off[2])} : cv::Vec3d{};
+        for (const cv::Rect& r : band)
+            for (int y = r.y + 1; y < std::min(r.y + r.height, a.sideMask.rows); ++y) {
+                if (!a.sideMask.at<std::uint8_t>(y, r.x)) continue;
+                const cv::Vec3f& l = a.sideLab.at<cv::Vec3f>(y, r.x);
+                if (labDistance(l, a.skinLab) <= kSkinRadius) continue;
+                if (seen && labDistance(l, backdrop) < labDistance(l, crownLabSeen)) continue;
+                const cv::Vec3b& b = a.side.at<cv::Vec3b>(y, r.x);
+                for (std::size_t c = 0; c < 3; ++c) hairLab[c].push_back(l[static_cast<int>(c)]), hairBgr[c].push_back(b[static_cast<int>(c)]);
+            }
+        a.hairLab = {median(hairLab[0]), median(hairLab[1]), median(hairLab[2])};
+        out.hairLab = a.hairLab;
+        out.colour = {median(hairBgr[0]), median(hairBgr[1]), median(hairBgr[2])};
+    }
     // The front's hair is what joins the crown or the temples (where the hair's colour was read).
     std::vector<cv::Rect> frontSeeds = a.crown;
     frontSeeds.insert(frontSeeds.end(), a.temples.begin(), a.temples.end());
