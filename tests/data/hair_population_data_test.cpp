@@ -161,5 +161,7 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
     EXPECT_GE(beardRight, analysed * 9 / 10);
     EXPECT_GE(moustacheRight, analysed * 9 / 10);
     EXPECT_GE(withHair, 18);
-    EXPECT_LT(medianDe, 15.0);
+    // The colour from the front's crown and temples and the side's crown: dE median 8.7 when this was written (10.2
+    // from the front alone).
+    EXPECT_LT(medianDe, 9.5);
 }
