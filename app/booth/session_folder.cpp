@@ -8,6 +8,7 @@
 #include "common/image_io.h"
 #include "common/landmark_names.h"
 #include "fit/export/glb.h"
+#include "fit/parts/hair_part.h"
 #include "render/mesh_renderer.h"
 #include "render/previews.h"
 
@@ -87,7 +88,9 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
         const HairEstimate& h = o.hair;
         const HairEvidence& e = h.evidence;
         const auto bgr = [](const cv::Vec3d& c) { return nlohmann::json{c[0], c[1], c[2]}; };
+        const char* proxy = hairProxyName(h.style);
         report["hair"] = {{"style", toString(h.style)},
+                          {"proxy", proxy ? nlohmann::json(proxy) : nlohmann::json(nullptr)},
                           {"colour_bgr", bgr(h.colour)},
                           {"skin_bgr", bgr(h.skinColour)},
                           {"beard", h.beard},
@@ -98,6 +101,13 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
                                         {"below_chin", e.belowChin}, {"behind_head", e.behindHead},
                                         {"down_the_back", e.downTheBack}, {"chin_darkening", e.chinDarkening},
                                         {"upper_lip_darkening", e.upperLipDarkening}, {"jaw_darkening", e.jawDarkening}}}};
+        // Big hair's stretch to the photos' outlines, every 10 mm of height from the chin up (1: as the proxy came).
+        nlohmann::json stretch = nlohmann::json::array();
+        for (std::size_t i = 0; i < o.hairStretch.size(); i += 5) {
+            const HairStretch& s = o.hairStretch[i];
+            stretch.push_back({{"y_mm", s.y}, {"plus_x", s.plusX}, {"minus_x", s.minusX}, {"back", s.back}});
+        }
+        report["hair"]["stretch"] = stretch;
     }
     if (!o.fit.modifierWeights.empty()) {
         // The first fitting step: the MakeHuman modifiers it used, and the targets' RMS before and after it.

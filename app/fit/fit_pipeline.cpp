@@ -221,8 +221,9 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         if (isBigHair(out.hair.style)) {
             HairSilhouetteFit follow;
             follow.behind = out.hair.style != HairStyle::Ponytail;
-            fitHairToSilhouettes(hair->mesh, out.fit.mesh, out.fit.front, out.frontMask, out.fit.side, out.sideMask,
-                                 out.fit.mesh.positions[base_.frontFeatures.at(landmarkName(8))].y, follow);
+            out.hairStretch = fitHairToSilhouettes(hair->mesh, out.fit.mesh, out.fit.front, out.frontMask, out.fit.side,
+                                                   out.sideMask, out.fit.mesh.positions[base_.frontFeatures.at(landmarkName(8))].y,
+                                                   follow);
         }
         // The photo showed the face (its landmarks were all found): the avatar's hair leaves it clear too.
         keepFaceClear(hair->mesh, base_, out.fit.mesh);

@@ -12,6 +12,7 @@
 #include "fit/head/head_fit.h"
 #include "fit/head/photo_texture.h"
 #include "fit/parts/avatar_parts.h"
+#include "fit/parts/hair_part.h"
 
 #include <glm/glm.hpp>
 #include <opencv2/core.hpp>
@@ -55,6 +56,8 @@ struct FitOutcome {
     bool sideNoseImageRight = true;
     cv::Mat sideMask;
     HairEstimate hair;  // the hair style, its colour, beard and moustache (fit/face/hair_analysis.h)
+    // How big hair was stretched to the photos' outlines, band by band (fitHairToSilhouettes); empty otherwise.
+    std::vector<HairStretch> hairStretch;
     HeadFit fit;
     PhotoTexture texture;
     // The avatar as shown and exported (fit/parts/avatar_part.h): the head (fit.mesh without what the proxies

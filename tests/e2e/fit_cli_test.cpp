@@ -87,6 +87,10 @@ TEST(FitCli, WritesACompleteSessionFolderWithAValidGlb) {
     EXPECT_GE(crown, 0.0);
     EXPECT_LE(crown, 1.0);
     EXPECT_EQ(fitJson["hair"]["colour_bgr"].size(), 3u);
+    // ... and which MakeHuman proxy it wears (none when bald); big hair also says how it was stretched.
+    if (style == "none") EXPECT_TRUE(fitJson["hair"]["proxy"].is_null());
+    else EXPECT_EQ(fitJson["hair"]["proxy"].get<std::string>().rfind(style == "short" ? "short04" : style, 0), 0u) << fitJson["hair"];
+    EXPECT_EQ(fitJson["hair"]["stretch"].empty(), style == "none" || style == "short") << fitJson["hair"];
     // The previews show a head, not an empty grey square.
     const cv::Mat preview = cv::imread((out / "preview_front.png").string());
     ASSERT_FALSE(preview.empty());
