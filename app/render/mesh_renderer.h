@@ -2,6 +2,7 @@
 // coverage mask and depth images (OpenGL ES 3).
 #pragma once
 
+#include "common/booth_lights.h"
 #include "fit/head/mesh.h"
 #include "fit/parts/avatar_part.h"
 
@@ -69,12 +70,11 @@ struct MeshRendererOptions {
 // Not thread-safe: use one renderer from one thread at a time (see HeadlessEglContext::release()).
 class MeshRenderer {
 public:
-    // Directions towards the key and fill lights in eye space (x right, y up, z towards the viewer; normalised
-    // before use) and the light weights:
-    //   colour = min(1, texture * (kAmbient + kKey max(0, n.key) + kFill max(0, n.fill))).
-    static constexpr glm::dvec3 kKeyLightEye{0.35, 0.55, 0.76};
-    static constexpr glm::dvec3 kFillLightEye{-0.70, -0.05, 0.71};
-    static constexpr double kAmbient = 0.30, kKey = 0.65, kFill = 0.20;
+    // The booth's lights (common/booth_lights.h): directions towards the key and fill lights in eye space and the
+    // light weights, colour = min(1, texture * (kAmbient + kKey max(0, n.key) + kFill max(0, n.fill))).
+    static constexpr glm::dvec3 kKeyLightEye{booth_lights::kKeyEye[0], booth_lights::kKeyEye[1], booth_lights::kKeyEye[2]};
+    static constexpr glm::dvec3 kFillLightEye{booth_lights::kFillEye[0], booth_lights::kFillEye[1], booth_lights::kFillEye[2]};
+    static constexpr double kAmbient = booth_lights::kAmbient, kKey = booth_lights::kKey, kFill = booth_lights::kFill;
 
     using Options = MeshRendererOptions;
 

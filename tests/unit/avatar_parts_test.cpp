@@ -126,6 +126,72 @@ TEST(AvatarParts, TintKeepsThePatternAndAlpha) {
     EXPECT_EQ(out.at<cv::Vec4b>(1, 1), cv::Vec4b(7, 8, 9, 0));
 }
 
+TEST(AvatarParts, SurfacePerTexelSharesEachTrianglesAreaAmongItsTexels) {
+    // The 10 x 10 mm square over a 4 x 4 texture: each triangle's 50 mm² over the texels whose centres it holds.
+    // The diagonal's texel centres lie on both triangles' edges, so each triangle holds 10 of the 16 centres.
+    const cv::Mat w = surfacePerTexel(square(), {4, 4});
+    ASSERT_EQ(w.type(), CV_32F);
+    EXPECT_NEAR(cv::sum(w)[0], 100.0, 1e-4);
+    EXPECT_NEAR(w.at<float>(0, 3), 5.0, 1e-5);   // above the diagonal: triangle (0, 1, 2) only
+    EXPECT_NEAR(w.at<float>(3, 0), 5.0, 1e-5);   // below it: (0, 2, 3) only
+    EXPECT_NEAR(w.at<float>(1, 1), 10.0, 1e-5);  // on it: both
+    // Stretched to twice the height, the same texels cover twice the surface.
+    Mesh tall = square();
+    for (auto& p : tall.positions) p.y *= 2.0;
+    EXPECT_NEAR(surfacePerTexel(tall, {4, 4}).at<float>(0, 3), 10.0, 1e-5);
+    // A triangle smaller than a texel gives its area to the texel under its centre.
+    Mesh tiny;
+    tiny.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    tiny.uvs = {{0.30, 0.30}, {0.32, 0.30}, {0.30, 0.32}};
+    tiny.triangles = {{0, 1, 2}};
+    const cv::Mat t = surfacePerTexel(tiny, {4, 4});
+    EXPECT_NEAR(t.at<float>(1, 1), 0.5, 1e-6);
+    EXPECT_NEAR(cv::sum(t)[0], 0.5, 1e-6);
+}
+
+TEST(AvatarParts, TintWeightedByTheSurfaceShownAndItsOpacity) {
+    // Two texels of a strand: a light one (grey 120) on 3 mm² of surface, a dark one (grey 40) on 1 mm², and a
+    // third, light as can be, that no surface uses; then the dark one made half transparent.
+    cv::Mat texture(1, 3, CV_8UC4);
+    texture.at<cv::Vec4b>(0, 0) = {120, 120, 120, 255};
+    texture.at<cv::Vec4b>(0, 1) = {40, 40, 40, 255};
+    texture.at<cv::Vec4b>(0, 2) = {255, 255, 255, 255};
+    const cv::Mat mask(1, 3, CV_8U, cv::Scalar(255));
+    cv::Mat weights(1, 3, CV_32F, cv::Scalar(0));
+    weights.at<float>(0, 0) = 3.0f;
+    weights.at<float>(0, 1) = 1.0f;
+    // The shown mean grey is (3 * 120 + 40) / 4 = 100: the light texel gets 1.2 of the colour, the dark one 0.4.
+    cv::Mat out = tintTexture(texture, mask, {50, 100, 150}, weights);
+    EXPECT_NEAR(out.at<cv::Vec4b>(0, 0)[2], 180, 1.0);
+    EXPECT_NEAR(out.at<cv::Vec4b>(0, 1)[1], 40, 1.0);
+    texture.at<cv::Vec4b>(0, 1)[3] = 51;  // 0.2 opaque: (3 * 120 + 0.2 * 40) / 3.2 = 115
+    out = tintTexture(texture, mask, {50, 100, 150}, weights);
+    EXPECT_NEAR(out.at<cv::Vec4b>(0, 0)[0], 50 * 120 / 115.0, 1.0);
+    EXPECT_EQ(out.at<cv::Vec4b>(0, 1)[3], 51);
+    // Without weights, the plain mean of the masked texels (415 / 3) as before.
+    out = tintTexture(texture, mask, {50, 100, 150});
+    EXPECT_NEAR(out.at<cv::Vec4b>(0, 0)[0], 50 * 120 / (415.0 / 3.0), 1.0);
+}
+
+TEST(AvatarParts, PlacedPartCutBelowAHeightKeepsOnlyWhatReachesAboveIt) {
+    BaseHead base;
+    base.mesh = square();
+    HeadProxy p = proxyOnSquare();
+    // A second triangle wholly under y = 3: its new vertex 3 lies at y = 0, on the square's bottom edge.
+    p.binding.vertices.push_back({0, 1, 2});
+    p.binding.weights.push_back({0.5, 0.5, 0.0});
+    p.binding.offsets.push_back({0, 0, 0});
+    p.mesh.uvs.push_back({1, 1});
+    p.mesh.triangles.push_back({0, 1, 3});
+    const AvatarPart all = placeProxyPart(p, base.mesh);
+    EXPECT_EQ(all.mesh.triangles.size(), 2u);
+    EXPECT_EQ(all.mesh.positions.size(), 4u);
+    const AvatarPart cut = placeProxyPart(p, base.mesh, nullptr, 3.0);
+    ASSERT_EQ(cut.mesh.triangles.size(), 1u);  // (0, 1, 2): its vertex 2 stands at y = 8
+    EXPECT_EQ(cut.mesh.positions.size(), 3u);
+    EXPECT_EQ(cut.mesh.uvs.size(), 3u);
+}
+
 TEST(AvatarParts, HeadWithoutReplacedVerticesAndDrawingOrder) {
     const Mesh cut = withoutVertices(square(), {3});
     ASSERT_EQ(cut.triangles.size(), 1u);  // (0, 2, 3) used vertex 3

@@ -7,7 +7,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 
 namespace avatarbooth {
 
@@ -34,14 +36,66 @@ Mesh withoutVertices(const Mesh& mesh, const std::vector<std::uint32_t>& vertice
     return out;
 }
 
-cv::Mat tintTexture(const cv::Mat& texture, const cv::Mat& mask, const cv::Vec3d& bgr) {
+cv::Mat surfacePerTexel(const Mesh& mesh, cv::Size size) {
+    cv::Mat weights(size, CV_32F, cv::Scalar(0));
+    if (mesh.uvs.size() != mesh.positions.size() || size.area() <= 0) return weights;
+    for (const glm::uvec3& t : mesh.triangles) {
+        const glm::dvec3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
+        const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+        std::array<glm::dvec2, 3> q;
+        for (int k = 0; k < 3; ++k) q[static_cast<std::size_t>(k)] = mesh.uvs[t[k]] * glm::dvec2(size.width, size.height);
+        const double twice = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[2].x - q[0].x) * (q[1].y - q[0].y);
+        const int x0 = std::max(0, static_cast<int>(std::floor(std::min({q[0].x, q[1].x, q[2].x}))));
+        const int x1 = std::min(size.width - 1, static_cast<int>(std::ceil(std::max({q[0].x, q[1].x, q[2].x}))));
+        const int y0 = std::max(0, static_cast<int>(std::floor(std::min({q[0].y, q[1].y, q[2].y}))));
+        const int y1 = std::min(size.height - 1, static_cast<int>(std::ceil(std::max({q[0].y, q[1].y, q[2].y}))));
+        std::vector<cv::Point> inside;
+        if (std::abs(twice) > 1e-12)
+            for (int y = y0; y <= y1; ++y)
+                for (int x = x0; x <= x1; ++x) {
+                    const glm::dvec2 p(x + 0.5, y + 0.5);
+                    const auto edge = [&](const glm::dvec2& u, const glm::dvec2& v) {
+                        return ((v.x - u.x) * (p.y - u.y) - (p.x - u.x) * (v.y - u.y)) / twice;
+                    };
+                    if (edge(q[0], q[1]) >= 0 && edge(q[1], q[2]) >= 0 && edge(q[2], q[0]) >= 0) inside.emplace_back(x, y);
+                }
+        if (inside.empty()) {
+            const glm::dvec2 m = (q[0] + q[1] + q[2]) / 3.0;
+            inside.emplace_back(std::clamp(static_cast<int>(m.x), 0, size.width - 1), std::clamp(static_cast<int>(m.y), 0, size.height - 1));
+        }
+        const float share = static_cast<float>(area / static_cast<double>(inside.size()));
+        for (const cv::Point& p : inside) weights.at<float>(p) += share;
+    }
+    return weights;
+}
+
+cv::Mat tintTexture(const cv::Mat& texture, const cv::Mat& mask, const cv::Vec3d& bgr, const cv::Mat& weights) {
     if (texture.size() != mask.size() || mask.type() != CV_8U || (texture.type() != CV_8UC3 && texture.type() != CV_8UC4))
         throw BoothError(ErrorKind::Internal, "tint", "needs an 8-bit BGR(A) texture and an 8-bit mask of its size");
+    if (!weights.empty() && (weights.size() != texture.size() || weights.type() != CV_32F))
+        throw BoothError(ErrorKind::Internal, "tint", "its weights must be CV_32F and of the texture's size");
     cv::Mat grey;
     cv::cvtColor(texture, grey, texture.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
-    const double meanGrey = std::max(1.0, cv::mean(grey, mask)[0]);
-    cv::Mat out = texture.clone();
     const int channels = texture.channels();
+    double meanGrey = cv::mean(grey, mask)[0];
+    if (!weights.empty()) {
+        double sum = 0.0, total = 0.0;
+        for (int r = 0; r < texture.rows; ++r) {
+            const auto* m = mask.ptr<std::uint8_t>(r);
+            const auto* g = grey.ptr<std::uint8_t>(r);
+            const auto* w = weights.ptr<float>(r);
+            const auto* t = texture.ptr<std::uint8_t>(r);
+            for (int c = 0; c < texture.cols; ++c) {
+                if (m[c] == 0) continue;
+                const double seen = w[c] * (channels == 4 ? t[c * 4 + 3] / 255.0 : 1.0);
+                sum += seen * g[c];
+                total += seen;
+            }
+        }
+        if (total > 0.0) meanGrey = sum / total;
+    }
+    meanGrey = std::max(1.0, meanGrey);
+    cv::Mat out = texture.clone();
     for (int r = 0; r < out.rows; ++r) {
         const auto* m = mask.ptr<std::uint8_t>(r);
         const auto* g = grey.ptr<std::uint8_t>(r);
@@ -83,14 +137,40 @@ void alignToPoints(AvatarPart& part, const Mesh& head, const std::vector<glm::dv
     }
 }
 
-AvatarPart placeProxyPart(const HeadProxy& proxy, const Mesh& fittedHead, const cv::Vec3d* colour) {
+namespace {
+
+// The triangles with a vertex at or above `keepAbove`, and the vertices they use (UVs kept with them).
+Mesh trianglesAbove(const Mesh& mesh, double keepAbove) {
+    const bool withUvs = mesh.uvs.size() == mesh.positions.size();
+    Mesh out;
+    std::vector<std::uint32_t> newIndex(mesh.positions.size(), UINT32_MAX);
+    const auto keep = [&](std::uint32_t v) {
+        if (newIndex[v] == UINT32_MAX) {
+            newIndex[v] = static_cast<std::uint32_t>(out.positions.size());
+            out.positions.push_back(mesh.positions[v]);
+            if (withUvs) out.uvs.push_back(mesh.uvs[v]);
+        }
+        return newIndex[v];
+    };
+    for (const glm::uvec3& t : mesh.triangles)
+        if (mesh.positions[t.x].y >= keepAbove || mesh.positions[t.y].y >= keepAbove || mesh.positions[t.z].y >= keepAbove)
+            out.triangles.emplace_back(keep(t.x), keep(t.y), keep(t.z));
+    return out;
+}
+
+}  // namespace
+
+AvatarPart placeProxyPart(const HeadProxy& proxy, const Mesh& fittedHead, const cv::Vec3d* colour, double keepAbove) {
     AvatarPart part;
     part.name = proxy.name;
     part.mesh.positions = placeProxy(proxy.binding, fittedHead.positions);
     part.mesh.uvs = proxy.mesh.uvs;
     part.mesh.triangles = proxy.mesh.triangles;
+    if (std::isfinite(keepAbove)) part.mesh = trianglesAbove(part.mesh, keepAbove);
     const auto [texture, tintMask] = proxyPixels(proxy);
-    part.texture = colour != nullptr && !tintMask.empty() ? tintTexture(texture, tintMask, *colour) : texture;
+    part.texture = colour != nullptr && !tintMask.empty()
+                       ? tintTexture(texture, tintMask, *colour, surfacePerTexel(part.mesh, texture.size()))
+                       : texture;
     part.alpha = proxy.alpha;
     part.alphaCutoff = proxy.alphaCutoff;
     return part;

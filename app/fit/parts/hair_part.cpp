@@ -1,6 +1,7 @@
 // The hair part (hair_part.h).
 #include "fit/parts/hair_part.h"
 
+#include "common/booth_lights.h"
 #include "common/error.h"
 #include "common/landmark_names.h"
 #include "fit/parts/avatar_parts.h"
@@ -119,7 +120,7 @@ std::vector<HairStretch> fitHairToSilhouettes(Mesh& hair, const Mesh& fittedHead
     const double midZ = 0.5 * (lo.z + hi.z);
     for (int i = 0; i < bands; ++i) {
         Band& x = b[static_cast<std::size_t>(i)];
-        if (x.headPlus < x.headMinus) continue;  // no head vertex at this height (over the skull: the hair's crown)
+        if (x.headPlus < x.headMinus) continue;  // the head's slice is empty here (over the skull: the hair's crown)
         const double y = chinY + (i + 0.5) * o.band;
         const cv::Point2d f = front.toPixel({0.0, y});
         if (const auto run = runThrough(frontMask, static_cast<int>(std::lround(f.y)), static_cast<int>(std::lround(f.x)))) {
@@ -128,8 +129,8 @@ std::vector<HairStretch> fitHairToSilhouettes(Mesh& hair, const Mesh& fittedHead
             x.k[0] = stretchTo(x.headPlus, x.plus, c, o);
             x.k[1] = stretchTo(-x.headMinus, -x.minus, -a, o);
         }
-        const cv::Point2d s = side.toPixel({midZ, y});
         if (!o.behind) continue;
+        const cv::Point2d s = side.toPixel({midZ, y});
         if (const auto run = runThrough(sideMask, static_cast<int>(std::lround(s.y)), static_cast<int>(std::lround(s.x)))) {
             const double a = side.toHead({static_cast<double>(run->first), s.y}).x, c = side.toHead({static_cast<double>(run->second), s.y}).x;
             x.k[2] = stretchTo(-x.headBack, -x.back, -std::min(a, c), o);
@@ -205,39 +206,25 @@ const HeadProxy* findHairProxy(const BaseHead& base, std::string_view proxyName)
     return nullptr;
 }
 
+cv::Vec3d hairPaint(const cv::Vec3d& seen) {
+    const double light = booth_lights::meanLightSeenOnSphere();
+    return {std::min(255.0, seen[0] / light), std::min(255.0, seen[1] / light), std::min(255.0, seen[2] / light)};
+}
+
 std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fittedHead, const HairEstimate& hair) {
     const char* name = hairProxyName(hair.style);
-    return name == nullptr ? std::nullopt : placeHairPart(base, fittedHead, name, hair.colour);
+    return name == nullptr ? std::nullopt : placeHairPart(base, fittedHead, name, hairPaint(hair.colour));
 }
 
 std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fittedHead, std::string_view proxyName,
                                         const cv::Vec3d& colour) {
     const HeadProxy* proxy = findHairProxy(base, proxyName);
     if (proxy == nullptr) return std::nullopt;
-    std::optional<AvatarPart> part = placeProxyPart(*proxy, fittedHead, &colour);
     // The avatar is a bust cut under the chin: long hair ends where the neck does, not in the air at waist height
     // (which also made every preview frame a head a third of its size).
-    if (part) {
-        glm::dvec3 lo, hi;
-        fittedHead.bounds(lo, hi);
-        // Only the vertices the kept triangles use stay (the previews frame a part by its vertices).
-        Mesh& m = part->mesh;
-        Mesh cut;
-        std::vector<std::uint32_t> newIndex(m.positions.size(), UINT32_MAX);
-        const auto keep = [&](std::uint32_t v) {
-            if (newIndex[v] == UINT32_MAX) {
-                newIndex[v] = static_cast<std::uint32_t>(cut.positions.size());
-                cut.positions.push_back(m.positions[v]);
-                if (!m.uvs.empty()) cut.uvs.push_back(m.uvs[v]);
-            }
-            return newIndex[v];
-        };
-        for (const auto& t : m.triangles)
-            if (m.positions[t.x].y >= lo.y || m.positions[t.y].y >= lo.y || m.positions[t.z].y >= lo.y)
-                cut.triangles.emplace_back(keep(t.x), keep(t.y), keep(t.z));
-        m = std::move(cut);
-    }
-    return part;
+    glm::dvec3 lo, hi;
+    fittedHead.bounds(lo, hi);
+    return placeProxyPart(*proxy, fittedHead, &colour, lo.y);
 }
 
 }  // namespace avatarbooth

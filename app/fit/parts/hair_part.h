@@ -70,10 +70,15 @@ std::vector<HairStretch> fitHairToSilhouettes(Mesh& hair, const Mesh& fittedHead
                                               const cv::Mat& frontMask, const PhotoFrame& side, const cv::Mat& sideMask,
                                               double chinY, const HairSilhouetteFit& options = {});
 
-// The hair part on `fittedHead` (the base head's topology), its strands in the estimate's colour; nothing when the
-// estimate says bald or the base head has no proxy for the style.
+// The colour to paint hair with so that it shows `seen` (the photo's, BGR 0..255) under the booth's lights: the
+// lights show hair, which wraps round the head, at booth_lights::meanLightSeenOnSphere() (0.75) of its colour on
+// average. HairPopulation's painted colours were read from their photos at 0.55-0.88 of themselves (median 0.75).
+cv::Vec3d hairPaint(const cv::Vec3d& seen);
+
+// The hair part on `fittedHead` (the base head's topology), its strands painted to show the estimate's colour
+// (hairPaint); nothing when the estimate says bald or the base head has no proxy for the style.
 std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fittedHead, const HairEstimate& hair);
-// Likewise for a named proxy of the base head (the synthetic visitors wear proxies the avatar does not).
+// A named proxy of the base head painted `colour` (the synthetic visitors wear proxies the avatar does not).
 std::optional<AvatarPart> placeHairPart(const BaseHead& base, const Mesh& fittedHead, std::string_view proxyName,
                                         const cv::Vec3d& colour);
 
