@@ -103,9 +103,10 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
         beardRight += e.beard == beard;
         moustacheRight += e.moustache == moustache;
         double dE = 0.0;
+        const cv::Vec3d painted = hairPaint(e.colour);
         if (p.hairStyle != "none" && e.style != HairStyle::None) {
             ++withHair;
-            dE = deltaE(hairPaint(e.colour), p.hairColour);
+            dE = deltaE(painted, p.hairColour);
             colourErrors.push_back(dE);
         }
         const HairEvidence& x = e.evidence;
@@ -114,7 +115,7 @@ TEST(HairPopulation, StyleColourAndBeardOfKnownPeople) {
                     seed, p.sex.c_str(), p.hairStyle.c_str(), p.hair.c_str(), toString(e.style), x.crown, x.hairFromSkin, x.foreheadFromSkin, x.crownHueShift,
                     x.crownSaturation, x.hairline, x.besideFace,
                     x.belowChin, x.clothesAsHair, x.behindHead, x.downTheBack, p.beard.c_str(), x.chinDarkening, x.upperLipDarkening,
-                    x.jawDarkening, e.beard ? "beard" : "-", e.moustache ? "+moustache" : "", dE, hairPaint(e.colour)[0], hairPaint(e.colour)[1], hairPaint(e.colour)[2],
+                    x.jawDarkening, e.beard ? "beard" : "-", e.moustache ? "+moustache" : "", dE, painted[0], painted[1], painted[2],
                     p.hairColour[0], p.hairColour[1], p.hairColour[2]);
     }
     std::printf("\nconfusion (rows: truth, columns: estimate)\n%-9s", "");

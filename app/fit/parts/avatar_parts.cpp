@@ -13,10 +13,11 @@
 
 namespace avatarbooth {
 
-Mesh withoutVertices(const Mesh& mesh, const std::vector<std::uint32_t>& vertices) {
-    std::vector<bool> dropped(mesh.positions.size(), false);
-    for (const auto v : vertices)
-        if (v < dropped.size()) dropped[v] = true;
+namespace {
+
+// The triangles `keepTriangle` holds for, and only the vertices they use (UVs kept with them), in first-use order.
+template <typename KeepTriangle>
+Mesh trianglesWhere(const Mesh& mesh, KeepTriangle keepTriangle) {
     constexpr std::uint32_t kUnused = ~0u;
     std::vector<std::uint32_t> newIndex(mesh.positions.size(), kUnused);
     Mesh out;
@@ -29,11 +30,18 @@ Mesh withoutVertices(const Mesh& mesh, const std::vector<std::uint32_t>& vertice
         }
         return newIndex[v];
     };
-    for (const auto& t : mesh.triangles) {
-        if (dropped[t.x] || dropped[t.y] || dropped[t.z]) continue;
-        out.triangles.emplace_back(keep(t.x), keep(t.y), keep(t.z));
-    }
+    for (const glm::uvec3& t : mesh.triangles)
+        if (keepTriangle(t)) out.triangles.emplace_back(keep(t.x), keep(t.y), keep(t.z));
     return out;
+}
+
+}  // namespace
+
+Mesh withoutVertices(const Mesh& mesh, const std::vector<std::uint32_t>& vertices) {
+    std::vector<bool> dropped(mesh.positions.size(), false);
+    for (const auto v : vertices)
+        if (v < dropped.size()) dropped[v] = true;
+    return trianglesWhere(mesh, [&](const glm::uvec3& t) { return !dropped[t.x] && !dropped[t.y] && !dropped[t.z]; });
 }
 
 cv::Mat surfacePerTexel(const Mesh& mesh, cv::Size size) {
@@ -77,7 +85,7 @@ cv::Mat tintTexture(const cv::Mat& texture, const cv::Mat& mask, const cv::Vec3d
     cv::Mat grey;
     cv::cvtColor(texture, grey, texture.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
     const int channels = texture.channels();
-    double meanGrey = cv::mean(grey, mask)[0];
+    double meanGrey = -1.0;
     if (!weights.empty()) {
         double sum = 0.0, total = 0.0;
         for (int r = 0; r < texture.rows; ++r) {
@@ -94,6 +102,7 @@ cv::Mat tintTexture(const cv::Mat& texture, const cv::Mat& mask, const cv::Vec3d
         }
         if (total > 0.0) meanGrey = sum / total;
     }
+    if (meanGrey < 0.0) meanGrey = cv::mean(grey, mask)[0];  // no weights, or no surface over the mask
     meanGrey = std::max(1.0, meanGrey);
     cv::Mat out = texture.clone();
     for (int r = 0; r < out.rows; ++r) {
@@ -137,36 +146,18 @@ void alignToPoints(AvatarPart& part, const Mesh& head, const std::vector<glm::dv
     }
 }
 
-namespace {
-
-// The triangles with a vertex at or above `keepAbove`, and the vertices they use (UVs kept with them).
-Mesh trianglesAbove(const Mesh& mesh, double keepAbove) {
-    const bool withUvs = mesh.uvs.size() == mesh.positions.size();
-    Mesh out;
-    std::vector<std::uint32_t> newIndex(mesh.positions.size(), UINT32_MAX);
-    const auto keep = [&](std::uint32_t v) {
-        if (newIndex[v] == UINT32_MAX) {
-            newIndex[v] = static_cast<std::uint32_t>(out.positions.size());
-            out.positions.push_back(mesh.positions[v]);
-            if (withUvs) out.uvs.push_back(mesh.uvs[v]);
-        }
-        return newIndex[v];
-    };
-    for (const glm::uvec3& t : mesh.triangles)
-        if (mesh.positions[t.x].y >= keepAbove || mesh.positions[t.y].y >= keepAbove || mesh.positions[t.z].y >= keepAbove)
-            out.triangles.emplace_back(keep(t.x), keep(t.y), keep(t.z));
-    return out;
-}
-
-}  // namespace
-
 AvatarPart placeProxyPart(const HeadProxy& proxy, const Mesh& fittedHead, const cv::Vec3d* colour, double keepAbove) {
     AvatarPart part;
     part.name = proxy.name;
     part.mesh.positions = placeProxy(proxy.binding, fittedHead.positions);
     part.mesh.uvs = proxy.mesh.uvs;
     part.mesh.triangles = proxy.mesh.triangles;
-    if (std::isfinite(keepAbove)) part.mesh = trianglesAbove(part.mesh, keepAbove);
+    if (std::isfinite(keepAbove)) {
+        const auto& p = part.mesh.positions;
+        part.mesh = trianglesWhere(part.mesh, [&](const glm::uvec3& t) {
+            return p[t.x].y >= keepAbove || p[t.y].y >= keepAbove || p[t.z].y >= keepAbove;
+        });
+    }
     const auto [texture, tintMask] = proxyPixels(proxy);
     part.texture = colour != nullptr && !tintMask.empty()
                        ? tintTexture(texture, tintMask, *colour, surfacePerTexel(part.mesh, texture.size()))

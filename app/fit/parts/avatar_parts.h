@@ -38,9 +38,8 @@ cv::Mat surfacePerTexel(const Mesh& mesh, cv::Size size);
 // The texture with its masked pixels recoloured: each keeps its own brightness relative to the masked pixels' mean
 // (the iris' fibres, the strands' grain) and their mean becomes `bgr`; alpha and unmasked pixels are kept. With
 // `weights` (surfacePerTexel), the mean is over the surface the texels cover and, in a BGRA texture, by how opaque
-// they are: the colour is then what the part shows on average. The hair proxies' textures are dark at the strands'
-// ends, which a bust cuts away, and light at the crown; their plain mean made the avatar's hair twice as light as
-// the colour measured on the photo (FRMDB 001: painted 65 38 30, drawn 122 78 65 RGB).
+// they are: the colour is then what the part shows on average (the hair proxies' textures are dark at the strands'
+// ends, which a bust cuts away, and light at the crown: their plain mean drew the hair far lighter than `bgr`).
 cv::Mat tintTexture(const cv::Mat& texture, const cv::Mat& mask, const cv::Vec3d& bgr, const cv::Mat& weights = {});
 
 // Moves a part up or down, each side of the face (x < 0, x > 0) on its own, so that its vertices within 4 mm (in x)

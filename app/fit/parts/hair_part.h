@@ -72,7 +72,7 @@ std::vector<HairStretch> fitHairToSilhouettes(Mesh& hair, const Mesh& fittedHead
 
 // The colour to paint hair with so that it shows `seen` (the photo's, BGR 0..255) under the booth's lights: the
 // lights show hair, which wraps round the head, at booth_lights::meanLightSeenOnSphere() (0.75) of its colour on
-// average. HairPopulation's painted colours were read from their photos at 0.55-0.88 of themselves (median 0.75).
+// average (the README gives what the synthetic visitors' photos showed of theirs).
 cv::Vec3d hairPaint(const cv::Vec3d& seen);
 
 // The hair part on `fittedHead` (the base head's topology), its strands painted to show the estimate's colour
