@@ -121,6 +121,27 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
             if (part.mesh.frontZ(p.x, p.y) > p.z) covered.push_back(landmarkName(k));  // NaN: no hair there
         }
         EXPECT_TRUE(covered.empty()) << "hair in front of " << ::testing::PrintToString(covered);
+        // Seen from either side, the head shows nowhere through long hair or a bob: the fitted head's ears stood out
+        // through long01 and were drawn as an arc on the hair (005, 006, 007) until tuckEarsUnderHair. Short hair and
+        // a ponytail leave the ears out (as 002's, 003's and 004's photos show them), so the ears stand out there.
+        const auto jawTop = [&](int k) { return mesh.positions[pipeline().baseHead().frontFeatures.at(landmarkName(k))].z; };
+        const double jawZ = 0.5 * (jawTop(0) + jawTop(16));
+        int through = 0, underHair = 0;
+        for (const double side : {1.0, -1.0}) {
+            Mesh fromSide = part.mesh;  // looking along -x (side +1) or +x (side -1): depth is side * x
+            for (glm::dvec3& q : fromSide.positions) q = {q.z, q.y, side * q.x};
+            for (const glm::dvec3& p : outcome.parts.front().mesh.positions) {
+                if (side * p.x <= 0.0 || std::abs(p.y) > 45.0 || p.z < -35.0 || p.z >= jawZ) continue;
+                const double hairDepth = fromSide.frontZ(p.z, p.y);
+                if (std::isnan(hairDepth)) continue;
+                ++underHair;
+                if (side * p.x > hairDepth) ++through;
+            }
+        }
+        std::printf("%s %s: %d of the %d head vertices beside the ears under hair show through it from the side\n", person,
+                    std::get<1>(GetParam()), through, underHair);
+        if (hairCoversEars(outcome.hair.style)) EXPECT_EQ(through, 0);
+        else EXPECT_GT(through, 0) << "the ears vanished under " << toString(outcome.hair.style) << " hair";
     }
     // The avatar's outline above the brows is the photos': with short hair the head fit follows the outline, so the
     // hair part must add no volume (short02 over the fitted heads of 002 and 003: 0.74-0.81; short04 0.91-0.95).

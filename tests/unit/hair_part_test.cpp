@@ -155,3 +155,59 @@ TEST(HairPart, HairWithinTheHeadsOutlineAndAPonytailsBackStayPut) {
     fitHairToSilhouettes(tail, head, frame(), mask(-100.0, 100.0), frame(), mask(-90.0, 90.0), -100.0, options);
     for (const glm::dvec3& p : tail.positions) EXPECT_TRUE(p.z == -120.0 || p.z == -90.0) << p.z;
 }
+
+namespace {
+
+// Two layers of hair beside the head on the +x side, flat sheets at x 80 (inner) and 84 (outer) over y -20..30 and
+// z -25..20; on the -x side none.
+Mesh hairSheetsOverTheLeftEar() {
+    Mesh m;
+    for (const double x : {80.0, 84.0}) {
+        const auto first = static_cast<std::uint32_t>(m.positions.size());
+        m.positions.insert(m.positions.end(), {{x, -20.0, -25.0}, {x, -20.0, 20.0}, {x, 30.0, 20.0}, {x, 30.0, -25.0}});
+        m.triangles.emplace_back(first, first + 1, first + 2);
+        m.triangles.emplace_back(first, first + 2, first + 3);
+    }
+    return m;
+}
+
+}  // namespace
+
+TEST(HairPart, AnEarStandingOutThroughTheHairIsTuckedUnderItsInnermostLayer) {
+    const Mesh hair = hairSheetsOverTheLeftEar();
+    Mesh head;
+    head.positions = {
+        {86.0, 0.0, -5.0},   // the ear's rim, out through both layers
+        {81.0, 10.0, 5.0},   // just through the inner layer
+        {78.0, 10.0, 5.0},   // 2 mm under it: already under the hair
+        {86.0, 0.0, 25.0},   // beyond the sheets (and ahead of the jaw's top, at z 22): no hair over it
+        {86.0, 40.0, -5.0},  // over the sheets
+        {-86.0, 0.0, -5.0},  // the other ear: no hair on that side
+        {86.0, 60.0, -5.0},  // out of the ears' window (45 mm over the ear holes)
+    };
+    const Mesh before = head;
+    EXPECT_EQ(tuckEarsUnderHair(head, hair, 22.0), 2);
+    EXPECT_DOUBLE_EQ(head.positions[0].x, 80.0 - 1.5);
+    EXPECT_DOUBLE_EQ(head.positions[1].x, 80.0 - 1.5);
+    // Only sideways.
+    EXPECT_EQ(head.positions[0].y, before.positions[0].y);
+    EXPECT_EQ(head.positions[0].z, before.positions[0].z);
+    for (const std::size_t k : {2u, 3u, 4u, 5u, 6u}) EXPECT_EQ(head.positions[k], before.positions[k]) << k;
+}
+
+TEST(HairPart, NothingAheadOfTheJawsTopIsTucked) {
+    const Mesh hair = hairSheetsOverTheLeftEar();
+    Mesh head;
+    // Over the sheets, but ahead of a jaw's top at z 0 (a cheek beside hair that keepFaceClear put under the skin).
+    head.positions = {{86.0, 0.0, 5.0}, {86.0, 0.0, -5.0}};
+    EXPECT_EQ(tuckEarsUnderHair(head, hair, 0.0), 1);
+    EXPECT_EQ(head.positions[0].x, 86.0);
+    EXPECT_DOUBLE_EQ(head.positions[1].x, 78.5);
+    // The same on the -x side, mirrored.
+    Mesh mirrored = hair;
+    for (glm::dvec3& p : mirrored.positions) p.x = -p.x;
+    Mesh other;
+    other.positions = {{-86.0, 0.0, -5.0}};
+    EXPECT_EQ(tuckEarsUnderHair(other, mirrored, 0.0), 1);
+    EXPECT_DOUBLE_EQ(other.positions[0].x, -78.5);
+}

@@ -42,6 +42,50 @@ void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, con
     }
 }
 
+int tuckEarsUnderHair(Mesh& head, const Mesh& hair, double jawZ, const EarTuck& tuck) {
+    // The window, in cells of the side-on map: columns along z (from behind to ahead), rows along y.
+    const double z0 = -tuck.behind, z1 = std::min(tuck.ahead, jawZ), y0 = -tuck.below, y1 = tuck.above;
+    if (z1 <= z0 || tuck.cell <= 0.0) return 0;
+    const int cols = static_cast<int>(std::ceil((z1 - z0) / tuck.cell)), rows = static_cast<int>(std::ceil((y1 - y0) / tuck.cell));
+    const double inf = std::numeric_limits<double>::infinity();
+    // The hair's innermost |x| over each cell, one map per side (+x, -x).
+    std::array<std::vector<double>, 2> inner{std::vector<double>(static_cast<std::size_t>(rows * cols), inf),
+                                             std::vector<double>(static_cast<std::size_t>(rows * cols), inf)};
+    for (const glm::uvec3& t : hair.triangles) {
+        const glm::dvec3& a = hair.positions[t[0]];
+        const glm::dvec3& b = hair.positions[t[1]];
+        const glm::dvec3& c = hair.positions[t[2]];
+        // A triangle across the middle is over the crown or the nape, not beside an ear.
+        if ((a.x > 0.0) != (b.x > 0.0) || (a.x > 0.0) != (c.x > 0.0)) continue;
+        auto& map = inner[a.x > 0.0 ? 0 : 1];
+        const double det = (b.z - a.z) * (c.y - a.y) - (c.z - a.z) * (b.y - a.y);
+        if (std::abs(det) < 1e-12) continue;  // edge-on from the side: its neighbours cover it
+        const int c0 = std::max(0, static_cast<int>(std::floor((std::min({a.z, b.z, c.z}) - z0) / tuck.cell)));
+        const int c1 = std::min(cols - 1, static_cast<int>(std::floor((std::max({a.z, b.z, c.z}) - z0) / tuck.cell)));
+        const int r0 = std::max(0, static_cast<int>(std::floor((std::min({a.y, b.y, c.y}) - y0) / tuck.cell)));
+        const int r1 = std::min(rows - 1, static_cast<int>(std::floor((std::max({a.y, b.y, c.y}) - y0) / tuck.cell)));
+        for (int r = r0; r <= r1; ++r)
+            for (int col = c0; col <= c1; ++col) {
+                const double z = z0 + (col + 0.5) * tuck.cell, y = y0 + (r + 0.5) * tuck.cell;
+                const double u = ((z - a.z) * (c.y - a.y) - (c.z - a.z) * (y - a.y)) / det;
+                const double v = ((b.z - a.z) * (y - a.y) - (z - a.z) * (b.y - a.y)) / det;
+                if (u < 0.0 || v < 0.0 || u + v > 1.0) continue;
+                double& m = map[static_cast<std::size_t>(r * cols + col)];
+                m = std::min(m, std::abs(a.x + u * (b.x - a.x) + v * (c.x - a.x)));
+            }
+    }
+    int moved = 0;
+    for (glm::dvec3& p : head.positions) {
+        if (p.z < z0 || p.z >= z1 || p.y < y0 || p.y >= y1) continue;
+        const int col = static_cast<int>((p.z - z0) / tuck.cell), r = static_cast<int>((p.y - y0) / tuck.cell);
+        const double limit = inner[p.x > 0.0 ? 0 : 1][static_cast<std::size_t>(r * cols + col)] - tuck.clearance;
+        if (std::abs(p.x) <= limit || limit <= 0.0) continue;  // under the hair already, or no hair over it
+        p.x = std::copysign(limit, p.x);
+        ++moved;
+    }
+    return moved;
+}
+
 namespace {
 
 // The run of mask pixels along `row` that holds column `through` (or the nearest run to it), as [first, last]

@@ -41,6 +41,28 @@ struct FaceClearance {
 // the booth must cope with.
 void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, const FaceClearance& clearance = {});
 
+// Where the head's ears keep under the hair (tuckEarsUnderHair), in millimetres, in the head's frame (the ear holes'
+// centre at the origin).
+struct EarTuck {
+    double clearance = 1.5;              // an ear under hair keeps this far inside the hair's innermost layer
+    double cell = 1.0;                   // the side-on map of the hair's innermost layer: its cell
+    double above = 45.0, below = 40.0;   // the ears' window: over and under the ear holes' centre
+    double ahead = 30.0, behind = 35.0;  // ... and before and behind it (never ahead of the jaw's top, `jawZ`)
+};
+
+// MakeHuman's hair styles cover the ears of its default head; a fitted head's ears stand out through long hair and
+// showed as an arc drawn on the hair from the side (FRMDB 005, 006, 007). Seen from either side, each head vertex in
+// the ears' window that lies outside the hair's innermost layer there is moved in, towards the middle, to
+// `clearance` inside it: an ear under hair stays under it; where no hair lies over it, the ear shows as it is.
+// `jawZ`: the depth of the jaw's top (ibug 0 and 16) on the fitted head, before which nothing moves (the face is
+// keepFaceClear's). Returns how many vertices moved.
+int tuckEarsUnderHair(Mesh& head, const Mesh& hair, double jawZ, const EarTuck& tuck = {});
+
+// Whether a style's proxy falls over the ears (long01, bob02), so that the fit tucks them under it. short04 and
+// ponytail01 leave the ears out, as FRMDB's photos of short hair and of hair tied back show them: there the ears
+// stand out of the proxy's edge as they do in the photo (tucked, they vanished under short04's sides).
+constexpr bool hairCoversEars(HairStyle style) { return style == HairStyle::Long || style == HairStyle::Bob; }
+
 // How the hair part follows the photos' silhouettes (fitHairToSilhouettes), in millimetres.
 struct HairSilhouetteFit {
     double band = 2.0;      // the height of one band of the outline
