@@ -337,5 +337,5 @@ TEST(AvatarParts, RenderedAndExported) {
         const auto& material = j["materials"][mesh["primitives"][0]["material"].get<std::size_t>()];
         alpha[node["name"]] = material.value("alphaMode", "OPAQUE");
     }
-    EXPECT_EQ(alpha, (std::map<std::string, std::string>{{"head", "OPAQUE"}, {"eyes", "OPAQUE"}, {"eyebrows", "BLEND"}, {"eyelashes", "MASK"}}));
+    EXPECT_EQ(alpha, (std::map<std::string, std::string>{{"head", "OPAQUE"}, {"eyes", "OPAQUE"}, {"eyebrows", "BLEND"}, {"eyelashes", "BLEND"}}));
 }

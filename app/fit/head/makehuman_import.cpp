@@ -737,8 +737,7 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
     }
     if (!options.eyelashes.empty()) {
         HeadProxy lashes = bindProxy("eyelashes", options.eyelashes, "eyelashes").first;
-        lashes.alpha = AlphaMode::Mask;
-        lashes.alphaCutoff = 0.3;
+        lashes.alpha = AlphaMode::Blend;
         head.proxies.push_back(std::move(lashes));
     }
     for (const std::string& style : options.hair) {
