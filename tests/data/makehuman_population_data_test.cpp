@@ -309,8 +309,8 @@ TEST(MakeHumanPopulation, FitsEveryPersonWithoutFoldsAndWithinTheMeasuredShapeEr
         EXPECT_EQ(detected.folds, 0u) << "seed " << seed << ", detected landmarks";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("face RMS (mm), median over %u people: base head %.2f; ground-truth landmarks %.2f (at the fit's own "
-                "scale %.2f), %d failures, %zu folds; detected %.2f (own scale %.2f), %d failures, %zu folds; %.0f s\n",
+    std::printf("face RMS (mm), median over %u people: base head %.2f; ground-truth landmarks %.3f (at the fit's own "
+                "scale %.2f), %d failures, %zu folds; detected %.3f (own scale %.2f), %d failures, %zu folds; %.0f s\n",
                 kPeople, median(baseRms), median(truthRms), median(truthOwnScale), truthFailures, truthFolds,
                 median(detectedRms), median(detectedOwnScale), detectedFailures, detectedFolds, seconds);
     if (tablesEnv && *tablesEnv) printFeatureTables(*base, samples, tablesEnv);
