@@ -136,7 +136,7 @@ uniform bool uLit;
 uniform vec3 uKeyDir;
 uniform vec3 uFillDir;
 uniform vec3 uWeights;  // ambient, key, fill
-uniform int uAlphaMode;  // 0 opaque, 1 mask, 2 blend (AlphaMode)
+uniform int uAlphaMode;  // 0 opaque, 1 mask, 2 blend (AlphaMode); 3 a masked part's fringe (under the cut-off)
 uniform float uAlphaCutoff;
 in vec3 vNormal;
 in float vDepth;
@@ -146,6 +146,7 @@ layout(location = 1) out vec4 oDepth;  // r: depth, g: coverage (resolves to the
 void main() {
     vec4 texel = texture(uTexture, vUv);
     if (uAlphaMode == 1 && texel.a < uAlphaCutoff) discard;
+    if (uAlphaMode == 3 && (texel.a >= uAlphaCutoff || texel.a < 1.0 / 255.0)) discard;
     vec3 colour = texel.rgb;
     if (uLit) {
         vec3 n = normalize(vNormal);
@@ -153,7 +154,7 @@ void main() {
         float light = uWeights.x + uWeights.y * max(dot(n, uKeyDir), 0.0) + uWeights.z * max(dot(n, uFillDir), 0.0);
         colour = min(colour * light, vec3(1.0));
     }
-    oColour = vec4(colour, uAlphaMode == 2 ? texel.a : 1.0);
+    oColour = vec4(colour, uAlphaMode >= 2 ? texel.a : 1.0);
     oDepth = vec4(vDepth, 1.0, 0.0, 0.0);
 }
 )";
@@ -632,6 +633,23 @@ void MeshRenderer::drawScene(const RenderCamera& camera, bool withDepth) {
                 glDepthMask(GL_FALSE);
             }
             glUniform1i(gl_->uAlphaMode, static_cast<int>(part.alpha));
+            glUniform1f(gl_->uAlphaCutoff, part.alphaCutoff);
+            glBindTexture(GL_TEXTURE_2D, part.texture);
+            glDrawElements(GL_TRIANGLES, part.indexCount, GL_UNSIGNED_INT,
+                           reinterpret_cast<const void*>(static_cast<std::size_t>(part.firstIndex) * sizeof(std::uint32_t)));
+        }
+        // A masked part's texels under its cut-off (the soft ends of hair strands and of its hairline) blended over
+        // everything drawn, in front of what is nearer than them: cut off alone, the strands' ends and the
+        // hairline's edge were steps of the texture's texels. Without sorting (thousands of strand cards), where two
+        // such ends overlap the nearer may be drawn first; at their opacity that does not show.
+        for (const Gl::Part& part : gl_->parts) {
+            if (part.indexCount == 0 || part.alpha != AlphaMode::Mask) continue;
+            const GLenum colourOnly[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+            glDrawBuffers(targets, colourOnly);
+            glEnable(GL_BLEND);
+            glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+            glDepthMask(GL_FALSE);
+            glUniform1i(gl_->uAlphaMode, 3);
             glUniform1f(gl_->uAlphaCutoff, part.alphaCutoff);
             glBindTexture(GL_TEXTURE_2D, part.texture);
             glDrawElements(GL_TRIANGLES, part.indexCount, GL_UNSIGNED_INT,

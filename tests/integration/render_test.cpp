@@ -428,8 +428,9 @@ TEST_F(RenderMesh, HundredRendersGiveTheSameImagesAndHoldNoNewGlObjects) {
 // ---- contexts ---------------------------------------------------------------------------------------------------
 
 // Parts: an opaque red square behind; in front a blended square of blue at alpha 0.5 over its left half and a masked
-// square whose right half is under its cutoff. Blended over red, masked dropped where under the cutoff, the masked
-// part hiding the red where kept; and the blended part writes no depth (the opaque part behind keeps its depth).
+// square whose right half is under its cutoff. Blended over red; the masked part hiding the red where kept, and where
+// under the cutoff (a strand's soft end) blended at its own alpha; neither the blended part nor the masked part's
+// fringe writes depth (the opaque part behind keeps its depth).
 TEST(RenderParts, OpaqueThenMaskedThenBlended) {
     std::vector<AvatarPart> parts(3);
     parts[0].mesh = square(80.0, {0, 0, -10});
@@ -458,12 +459,16 @@ TEST(RenderParts, OpaqueThenMaskedThenBlended) {
     EXPECT_NEAR(blended[0], 128, 3);
     EXPECT_NEAR(blended[2], 127, 3);
     EXPECT_EQ(r.bgr.at<cv::Vec3b>(at(10, 0)), kGreen);   // masked, kept
-    EXPECT_EQ(r.bgr.at<cv::Vec3b>(at(30, 0)), kRed);     // masked, under the cutoff
+    const cv::Vec3b fringe = r.bgr.at<cv::Vec3b>(at(30, 0));  // masked, under the cutoff: green at 20/255 over red
+    EXPECT_EQ(fringe[0], 0);
+    EXPECT_NEAR(fringe[1], 20, 2);
+    EXPECT_NEAR(fringe[2], 235, 2);
     EXPECT_EQ(r.bgr.at<cv::Vec3b>(at(-35, 30)), kRed);   // opaque alone
     EXPECT_EQ(r.mask.at<std::uint8_t>(at(-20, 0)), 255);
     // Depth: the blended square's pixels keep the opaque square's distance (510 mm), the masked one's its own.
     EXPECT_NEAR(r.depth.at<float>(at(-20, 0)), 510.0f, 0.5f);
     EXPECT_NEAR(r.depth.at<float>(at(10, 0)), 490.0f, 0.5f);
+    EXPECT_NEAR(r.depth.at<float>(at(30, 0)), 510.0f, 0.5f);
 }
 
 TEST(RenderEgl, ContextReportsItsRenderer) {
