@@ -108,6 +108,7 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
             stretch.push_back({{"y_mm", s.y}, {"plus_x", s.plusX}, {"minus_x", s.minusX}, {"back", s.back}});
         }
         report["hair"]["stretch"] = stretch;
+        report["hair"]["forehead_shown_mm"] = o.foreheadShownMm;
     }
     if (!o.fit.modifierWeights.empty()) {
         // The first fitting step: the MakeHuman modifiers it used, and the targets' RMS before and after it.

@@ -226,7 +226,13 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
                                                    follow);
         }
         // The photo showed the face (its landmarks were all found): the avatar's hair leaves it clear too.
-        keepFaceClear(hair->mesh, base_, out.fit.mesh);
+        // bob02's fringe falls to the brows; a visitor whose forehead shows has none (FRMDB 008: the fringe made a
+        // helmet of his parted curls). long01's and ponytail01's hair starts at the top of the forehead already:
+        // pushed back there, their strand cards' ends showed as steps (007).
+        FaceClearance clear;
+        if (out.hair.style == HairStyle::Bob) clear.above = foreheadShownMm(m.frontHair, out.frontLandmarks.points, out.fit.front);
+        out.foreheadShownMm = clear.above;
+        keepFaceClear(hair->mesh, base_, out.fit.mesh, clear);
         // The fitted head's ears stand out further than those MakeHuman's styles were made over.
         const auto jawTop = [&](int k) { return out.fit.mesh.positions[base_.frontFeatures.at(landmarkName(k))].z; };
         for (AvatarPart& part : out.parts)

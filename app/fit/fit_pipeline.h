@@ -56,6 +56,9 @@ struct FitOutcome {
     bool sideNoseImageRight = true;
     cv::Mat sideMask;
     HairEstimate hair;  // the hair style, its colour, beard and moustache (fit/face/hair_analysis.h)
+    // With a bob: how far over the brows the front photo shows the forehead, which the bob's fringe leaves clear
+    // (fit/parts/hair_part.h foreheadShownMm); 0 otherwise.
+    double foreheadShownMm = 0.0;
     // How big hair was stretched to the photos' outlines, band by band (fitHairToSilhouettes); empty otherwise.
     std::vector<HairStretch> hairStretch;
     HeadFit fit;

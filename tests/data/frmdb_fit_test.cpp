@@ -121,6 +121,23 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
             if (part.mesh.frontZ(p.x, p.y) > p.z) covered.push_back(landmarkName(k));  // NaN: no hair there
         }
         EXPECT_TRUE(covered.empty()) << "hair in front of " << ::testing::PrintToString(covered);
+        // Where the photo shows the forehead, a bob's fringe leaves it clear (008's parted curls: bob02's fringe down
+        // to his brows made a helmet of them): the forehead's middle from the brows to 10 mm under the hairline the
+        // photo shows is not behind hair.
+        if (outcome.hair.style == HairStyle::Bob) {
+            std::printf("%s %s: the photo shows %.1f mm of forehead over the brows\n", person, std::get<1>(GetParam()),
+                        outcome.foreheadShownMm);
+            const glm::dvec3& left = mesh.positions[pipeline().baseHead().frontFeatures.at(landmarkName(20))];
+            const glm::dvec3& right = mesh.positions[pipeline().baseHead().frontFeatures.at(landmarkName(23))];
+            std::vector<double> hidden;
+            for (double up = 2.0; up < outcome.foreheadShownMm - 10.0; up += 2.0)
+                for (const double t : {0.0, 0.5, 1.0}) {
+                    const glm::dvec3 p = left + t * (right - left) + glm::dvec3(0.0, up, 0.0);
+                    const double skin = mesh.frontZ(p.x, p.y), hair = part.mesh.frontZ(p.x, p.y);
+                    if (hair > skin) hidden.push_back(up);  // NaN: no hair there
+                }
+            EXPECT_TRUE(hidden.empty()) << "the forehead behind hair at " << ::testing::PrintToString(hidden) << " mm over the brows";
+        }
         // Seen from either side, the head shows nowhere through long hair or a bob: the fitted head's ears stood out
         // through long01 and were drawn as an arc on the hair (005, 006, 007) until tuckEarsUnderHair. Short hair and
         // a ponytail leave the ears out (as 002's, 003's and 004's photos show them), so the ears stand out there.

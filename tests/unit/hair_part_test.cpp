@@ -211,3 +211,53 @@ TEST(HairPart, NothingAheadOfTheJawsTopIsTucked) {
     EXPECT_EQ(tuckEarsUnderHair(other, mirrored, 0.0), 1);
     EXPECT_DOUBLE_EQ(other.positions[0].x, -78.5);
 }
+
+namespace {
+
+// A front photo at 0.5 mm a pixel with its middle brow points 19 and 24 at row 200, columns 100 and 140.
+std::array<cv::Point2d, 68> browsAtRow200() {
+    std::array<cv::Point2d, 68> points{};
+    points[19] = {100.0, 200.0};
+    points[24] = {140.0, 200.0};
+    return points;
+}
+
+PhotoFrame halfMillimetrePixels() {
+    PhotoFrame f;
+    f.mmPerPixel = 0.5;
+    return f;
+}
+
+}  // namespace
+
+TEST(HairPart, TheForeheadShownIsMeasuredFromTheBrowsToTheHairline) {
+    cv::Mat hair(400, 300, CV_8U, cv::Scalar(0));
+    hair.rowRange(0, 151).setTo(255);  // hair down to row 150: 50 rows, 25 mm over the brows
+    EXPECT_DOUBLE_EQ(foreheadShownMm(hair, browsAtRow200(), halfMillimetrePixels()), 25.0 - 3.0);
+    EXPECT_DOUBLE_EQ(foreheadShownMm(hair, browsAtRow200(), halfMillimetrePixels(), 0.0), 25.0);
+    // A stray hair pixel (under 2 mm of hair) on the forehead is no hairline.
+    hair.at<std::uint8_t>(180, 120) = 255;
+    hair.at<std::uint8_t>(179, 120) = 255;
+    EXPECT_DOUBLE_EQ(foreheadShownMm(hair, browsAtRow200(), halfMillimetrePixels(), 0.0), 25.0);
+}
+
+TEST(HairPart, AFringeOnTheBrowsOrNoHairlineShowsNoForehead) {
+    cv::Mat fringe(400, 300, CV_8U, cv::Scalar(0));
+    fringe.rowRange(0, 201).setTo(255);
+    EXPECT_DOUBLE_EQ(foreheadShownMm(fringe, browsAtRow200(), halfMillimetrePixels()), 0.0);
+    // No hair over most of the forehead's columns (a bald crown): nothing is said.
+    cv::Mat bald(400, 300, CV_8U, cv::Scalar(0));
+    bald(cv::Rect(100, 0, 10, 150)).setTo(255);
+    EXPECT_DOUBLE_EQ(foreheadShownMm(bald, browsAtRow200(), halfMillimetrePixels()), 0.0);
+    EXPECT_DOUBLE_EQ(foreheadShownMm(cv::Mat(), browsAtRow200(), halfMillimetrePixels()), 0.0);
+}
+
+TEST(HairPart, OverTheForeheadShownTheFaceIsKeptClearToo) {
+    const Face f = face();  // brows' lowest point at y 40, the jaw's plane at z 12
+    Mesh hair;
+    hair.positions = {{0.0, 60.0, 62.0}};  // a fringe 20 mm over the brows
+    FaceClearance clear;
+    clear.above = 30.0;
+    keepFaceClear(hair, f.base, f.head, clear);
+    EXPECT_NEAR(hair.positions[0].z, 12.0 + 10.0 * (1.0 - std::exp(-5.0)), 1e-9);
+}

@@ -29,6 +29,7 @@ void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, con
     };
     double browY = at(17).y;
     for (int k = 18; k <= 26; ++k) browY = std::min(browY, at(k).y);
+    browY += std::max(clearance.above, 0.0);
     const double sideZ = 0.5 * (at(0).z + at(16).z);
     for (glm::dvec3& p : hair.positions) {
         if (p.z <= sideZ) continue;
@@ -40,6 +41,34 @@ void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, con
         const double kept = clearance.depth * (1.0 - std::exp(-ahead / clearance.depth));
         p.z -= t * t * (3.0 - 2.0 * t) * (ahead - kept);
     }
+}
+
+double foreheadShownMm(const cv::Mat& hair, const std::array<cv::Point2d, 68>& points, const PhotoFrame& front,
+                       double margin) {
+    if (hair.empty() || hair.type() != CV_8U || front.mmPerPixel <= 0.0) return 0.0;
+    const int run = std::max(1, static_cast<int>(std::lround(2.0 / front.mmPerPixel)));
+    const int x0 = static_cast<int>(std::lround(std::min(points[19].x, points[24].x)));
+    const int x1 = static_cast<int>(std::lround(std::max(points[19].x, points[24].x)));
+    std::vector<double> shown;
+    for (int x = std::max(x0, 0); x <= std::min(x1, hair.cols - 1); ++x) {
+        // The brows' height at this column: the line between the middle brow points.
+        const double t = x1 > x0 ? static_cast<double>(x - x0) / (x1 - x0) : 0.0;
+        const cv::Point2d& a = points[19].x <= points[24].x ? points[19] : points[24];
+        const cv::Point2d& b = points[19].x <= points[24].x ? points[24] : points[19];
+        const int brow = static_cast<int>(std::lround(a.y + t * (b.y - a.y)));
+        int inHair = 0;
+        for (int y = std::min(brow, hair.rows - 1); y >= 0; --y) {
+            inHair = hair.at<std::uint8_t>(y, x) ? inHair + 1 : 0;
+            if (inHair == run) {
+                shown.push_back((brow - (y + run - 1)) * front.mmPerPixel);
+                break;
+            }
+        }
+    }
+    // Most columns must find a hairline: a bald or shaven crown has none, and then nothing is said.
+    if (shown.size() * 2 < static_cast<std::size_t>(std::max(x1 - x0 + 1, 1))) return 0.0;
+    std::nth_element(shown.begin(), shown.begin() + static_cast<std::ptrdiff_t>(shown.size() / 2), shown.end());
+    return std::max(0.0, shown[shown.size() / 2] - margin);
 }
 
 int tuckEarsUnderHair(Mesh& head, const Mesh& hair, double jawZ, const EarTuck& tuck) {

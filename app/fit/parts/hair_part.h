@@ -30,7 +30,17 @@ const HeadProxy* findHairProxy(const BaseHead& base, std::string_view proxyName)
 struct FaceClearance {
     double depth = 10.0;  // under the brows, what was ahead of the plane through the jaw's top keeps within this of it
     double ramp = 15.0;   // over the brows, the push fades out over this height
+    // How far over the brows the face is kept clear as well: the forehead the photo shows as skin up to its hairline
+    // (foreheadShownMm). 0: up to the brows, as under a fringe.
+    double above = 0.0;
 };
+
+// How far over the brows the front photo shows the forehead's skin, in millimetres: going up each column of the
+// forehead's middle (between brow points 19 and 24) from the brows, the first 2 mm of hair pixels (`hair`, CV_8U)
+// is the hairline there; the median over the columns, less `margin`. 0 when hair lies on the brows (a fringe) or no
+// hairline is found under the head's top.
+double foreheadShownMm(const cv::Mat& hair, const std::array<cv::Point2d, 68>& points, const PhotoFrame& front,
+                       double margin = 3.0);
 
 // Moves the hair that would hang in front of the face the photo shows. MakeHuman's styles are made for its default
 // head; on the fitted heads bob02's fringe fell over an eye and its sides hid the cheeks from three-quarter view.
