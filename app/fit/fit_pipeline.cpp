@@ -234,9 +234,9 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         out.foreheadShownMm = clear.above;
         keepFaceClear(hair->mesh, base_, out.fit.mesh, clear);
         // The fitted head's ears stand out further than those MakeHuman's styles were made over.
-        const auto jawTop = [&](int k) { return out.fit.mesh.positions[base_.frontFeatures.at(landmarkName(k))].z; };
-        for (AvatarPart& part : out.parts)
-            if (part.name == "head" && hairCoversEars(out.hair.style)) tuckEarsUnderHair(part.mesh, hair->mesh, 0.5 * (jawTop(0) + jawTop(16)));
+        if (hairCoversEars(out.hair.style))
+            for (AvatarPart& part : out.parts)
+                if (part.name == "head") tuckEarsUnderHair(part.mesh, hair->mesh, jawTopDepth(base_, out.fit.mesh));
         out.parts.push_back(std::move(*hair));
     }
     // The brows onto the photo's own (which the texture shows where the fit put dlib's brow points): dlib puts them on

@@ -642,14 +642,14 @@ void MeshRenderer::drawScene(const RenderCamera& camera, bool withDepth) {
         // everything drawn, in front of what is nearer than them: cut off alone, the strands' ends and the
         // hairline's edge were steps of the texture's texels. Without sorting (thousands of strand cards), where two
         // such ends overlap the nearer may be drawn first; at their opacity that does not show.
+        const GLenum colourOnly[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+        glDrawBuffers(targets, colourOnly);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        glDepthMask(GL_FALSE);
+        glUniform1i(gl_->uAlphaMode, 3);
         for (const Gl::Part& part : gl_->parts) {
             if (part.indexCount == 0 || part.alpha != AlphaMode::Mask) continue;
-            const GLenum colourOnly[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
-            glDrawBuffers(targets, colourOnly);
-            glEnable(GL_BLEND);
-            glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-            glDepthMask(GL_FALSE);
-            glUniform1i(gl_->uAlphaMode, 3);
             glUniform1f(gl_->uAlphaCutoff, part.alphaCutoff);
             glBindTexture(GL_TEXTURE_2D, part.texture);
             glDrawElements(GL_TRIANGLES, part.indexCount, GL_UNSIGNED_INT,

@@ -141,8 +141,7 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
         // Seen from either side, the head shows nowhere through long hair or a bob: the fitted head's ears stood out
         // through long01 and were drawn as an arc on the hair (005, 006, 007) until tuckEarsUnderHair. Short hair and
         // a ponytail leave the ears out (as 002's, 003's and 004's photos show them), so the ears stand out there.
-        const auto jawTop = [&](int k) { return mesh.positions[pipeline().baseHead().frontFeatures.at(landmarkName(k))].z; };
-        const double jawZ = 0.5 * (jawTop(0) + jawTop(16));
+        const double jawZ = jawTopDepth(pipeline().baseHead(), mesh);
         int through = 0, underHair = 0;
         for (const double side : {1.0, -1.0}) {
             Mesh fromSide = part.mesh;  // looking along -x (side +1) or +x (side -1): depth is side * x

@@ -20,17 +20,27 @@
 
 namespace avatarbooth {
 
+namespace {
+
+// Landmark k's feature vertex on the fitted head.
+const glm::dvec3& featureOn(const BaseHead& base, const Mesh& fittedHead, int k) {
+    const auto it = base.frontFeatures.find(landmarkName(k));
+    if (it == base.frontFeatures.end() || it->second >= fittedHead.positions.size())
+        throw BoothError(ErrorKind::Internal, "hair part", "the base head has no feature vertex " + landmarkName(k));
+    return fittedHead.positions[it->second];
+}
+
+}  // namespace
+
+double jawTopDepth(const BaseHead& base, const Mesh& fittedHead) {
+    return 0.5 * (featureOn(base, fittedHead, 0).z + featureOn(base, fittedHead, 16).z);
+}
+
 void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, const FaceClearance& clearance) {
-    const auto at = [&](int k) -> const glm::dvec3& {
-        const auto it = base.frontFeatures.find(landmarkName(k));
-        if (it == base.frontFeatures.end() || it->second >= fittedHead.positions.size())
-            throw BoothError(ErrorKind::Internal, "hair part", "the base head has no feature vertex " + landmarkName(k));
-        return fittedHead.positions[it->second];
-    };
-    double browY = at(17).y;
-    for (int k = 18; k <= 26; ++k) browY = std::min(browY, at(k).y);
+    double browY = featureOn(base, fittedHead, 17).y;
+    for (int k = 18; k <= 26; ++k) browY = std::min(browY, featureOn(base, fittedHead, k).y);
     browY += std::max(clearance.above, 0.0);
-    const double sideZ = 0.5 * (at(0).z + at(16).z);
+    const double sideZ = jawTopDepth(base, fittedHead);
     for (glm::dvec3& p : hair.positions) {
         if (p.z <= sideZ) continue;
         // 0 from `ramp` over the brows up, 1 from the brows down, smooth between (no crease in a strand).
@@ -47,14 +57,14 @@ double foreheadShownMm(const cv::Mat& hair, const std::array<cv::Point2d, 68>& p
                        double margin) {
     if (hair.empty() || hair.type() != CV_8U || front.mmPerPixel <= 0.0) return 0.0;
     const int run = std::max(1, static_cast<int>(std::lround(2.0 / front.mmPerPixel)));
-    const int x0 = static_cast<int>(std::lround(std::min(points[19].x, points[24].x)));
-    const int x1 = static_cast<int>(std::lround(std::max(points[19].x, points[24].x)));
+    // The middle brow points from left to right in the photo.
+    const cv::Point2d& a = points[19].x <= points[24].x ? points[19] : points[24];
+    const cv::Point2d& b = points[19].x <= points[24].x ? points[24] : points[19];
+    const int x0 = static_cast<int>(std::lround(a.x)), x1 = static_cast<int>(std::lround(b.x));
     std::vector<double> shown;
     for (int x = std::max(x0, 0); x <= std::min(x1, hair.cols - 1); ++x) {
         // The brows' height at this column: the line between the middle brow points.
         const double t = x1 > x0 ? static_cast<double>(x - x0) / (x1 - x0) : 0.0;
-        const cv::Point2d& a = points[19].x <= points[24].x ? points[19] : points[24];
-        const cv::Point2d& b = points[19].x <= points[24].x ? points[24] : points[19];
         const int brow = static_cast<int>(std::lround(a.y + t * (b.y - a.y)));
         int inHair = 0;
         for (int y = std::min(brow, hair.rows - 1); y >= 0; --y) {

@@ -42,6 +42,10 @@ struct FaceClearance {
 double foreheadShownMm(const cv::Mat& hair, const std::array<cv::Point2d, 68>& points, const PhotoFrame& front,
                        double margin = 3.0);
 
+// The depth of the plane through the jaw's top (ibug 0 and 16) on the fitted head, before which lies the face the
+// photo shows (keepFaceClear, tuckEarsUnderHair). Throws BoothError(Internal) when the base head lacks those points.
+double jawTopDepth(const BaseHead& base, const Mesh& fittedHead);
+
 // Moves the hair that would hang in front of the face the photo shows. MakeHuman's styles are made for its default
 // head; on the fitted heads bob02's fringe fell over an eye and its sides hid the cheeks from three-quarter view.
 // Under the brows, the hair ahead of the plane through the jaw's top (ibug 0 and 16) is pushed back to within
