@@ -109,6 +109,7 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
         }
         report["hair"]["stretch"] = stretch;
         report["hair"]["forehead_shown_mm"] = o.foreheadShownMm;
+        report["hair"]["trimmed_vertices"] = o.hairTrimmedVertices;
     }
     if (!o.fit.modifierWeights.empty()) {
         // The first fitting step: the MakeHuman modifiers it used, and the targets' RMS before and after it.

@@ -233,6 +233,11 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         if (out.hair.style == HairStyle::Bob) clear.above = foreheadShownMm(m.frontHair, out.frontLandmarks.points, out.fit.front);
         out.foreheadShownMm = clear.above;
         keepFaceClear(hair->mesh, base_, out.fit.mesh, clear);
+        if (out.hair.style == HairStyle::Short && settings_.trimShortHair) {
+            HairPhotoMasks masks{hairPixels(front, out.frontMask, out.hair), out.frontMask, hairPixels(side, out.sideMask, out.hair),
+                                 out.sideMask, out.fit.front, out.fit.side};
+            out.hairTrimmedVertices = trimShortHairToPhotos(hair->mesh, out.fit.mesh, masks);
+        }
         // The fitted head's ears stand out further than those MakeHuman's styles were made over.
         if (hairCoversEars(out.hair.style))
             for (AvatarPart& part : out.parts)

@@ -32,6 +32,8 @@ struct FitSettings {
     std::filesystem::path landmarkModel = AVATARBOOTH_DEFAULT_DLIB_MODEL;
     HeadFitOptions head = defaultHeadFitOptions();
     PhotoTextureOptions texture;
+    // Short hair trimmed to where the photos show hair (fit/parts/hair_part.h trimShortHairToPhotos).
+    bool trimShortHair = true;
 };
 
 // The files one fit reads.
@@ -59,6 +61,9 @@ struct FitOutcome {
     // With a bob: how far over the brows the front photo shows the forehead, which the bob's fringe leaves clear
     // (fit/parts/hair_part.h foreheadShownMm); 0 otherwise.
     double foreheadShownMm = 0.0;
+    // With short hair: how many of the hair part's vertices went where the photos show skin (fit/parts/hair_part.h
+    // trimShortHairToPhotos); 0 otherwise.
+    int hairTrimmedVertices = 0;
     // How big hair was stretched to the photos' outlines, band by band (fitHairToSilhouettes); empty otherwise.
     std::vector<HairStretch> hairStretch;
     HeadFit fit;

@@ -156,8 +156,9 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
         }
         std::printf("%s %s: %d of the %d head vertices beside the ears under hair show through it from the side\n", person,
                     std::get<1>(GetParam()), through, underHair);
+        // (003's short hair, trimmed to his fade, leaves no hair beside his ears at all.)
         if (hairCoversEars(outcome.hair.style)) EXPECT_EQ(through, 0);
-        else EXPECT_GT(through, 0) << "the ears vanished under " << toString(outcome.hair.style) << " hair";
+        else EXPECT_TRUE(underHair == 0 || through > 0) << "the ears vanished under " << toString(outcome.hair.style) << " hair";
     }
     // The avatar's outline above the brows is the photos': with short hair the head fit follows the outline, so the
     // hair part must add no volume (short02 over the fitted heads of 002 and 003: 0.74-0.81; short04 0.91-0.95).

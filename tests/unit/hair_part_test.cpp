@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -260,4 +261,101 @@ TEST(HairPart, OverTheForeheadShownTheFaceIsKeptClearToo) {
     clear.above = 30.0;
     keepFaceClear(hair, f.base, f.head, clear);
     EXPECT_NEAR(hair.positions[0].z, 12.0 + 10.0 * (1.0 - std::exp(-5.0)), 1e-9);
+}
+
+namespace {
+
+// A latitude-longitude sphere of the given radius about the origin (y up), its rings from the top down to `lowestY`.
+Mesh sphere(double radius, double lowestY, int rings = 36, int segments = 72) {
+    Mesh m;
+    std::vector<int> kept;
+    for (int r = 1; r < rings; ++r) {
+        const double polar = M_PI * r / rings;
+        if (radius * std::cos(polar) < lowestY) break;
+        for (int s = 0; s < segments; ++s) {
+            const double az = 2.0 * M_PI * s / segments;
+            m.positions.emplace_back(radius * std::sin(polar) * std::sin(az), radius * std::cos(polar),
+                                     radius * std::sin(polar) * std::cos(az));
+        }
+        kept.push_back(r);
+    }
+    const auto at = [&](int ring, int s) { return static_cast<std::uint32_t>(ring * segments + (s % segments)); };
+    for (int ring = 0; ring + 1 < static_cast<int>(kept.size()); ++ring)
+        for (int s = 0; s < segments; ++s) {
+            m.triangles.emplace_back(at(ring, s), at(ring + 1, s), at(ring + 1, s + 1));
+            m.triangles.emplace_back(at(ring, s), at(ring + 1, s + 1), at(ring, s + 1));
+        }
+    return m;
+}
+
+// Photos of a round head of radius 90 at 1 mm per pixel (frame()): the person a disc, hair over head height `hairFromY`.
+HairPhotoMasks roundHeadPhotos(double hairFromY) {
+    HairPhotoMasks p;
+    p.front = p.side = frame();
+    p.frontPerson = cv::Mat::zeros(400, 400, CV_8U);
+    cv::circle(p.frontPerson, {200, 200}, 90, cv::Scalar(255), cv::FILLED);
+    p.sidePerson = p.frontPerson.clone();
+    p.frontHair = p.frontPerson.clone();
+    p.frontHair.rowRange(static_cast<int>(200 - hairFromY), 400).setTo(0);
+    p.sideHair = p.frontHair.clone();
+    return p;
+}
+
+}  // namespace
+
+TEST(HairPart, ShortHairGoesWhereThePhotosShowSkinAndStaysWhereTheyShowHair) {
+    const Mesh head = sphere(90.0, -200.0);
+    Mesh hair = sphere(91.5, -60.0);
+    const std::size_t before = hair.positions.size();
+    std::size_t over40 = 0;
+    for (const auto& p : hair.positions) over40 += p.y > 40.0;
+    const int gone = trimShortHairToPhotos(hair, head, roundHeadPhotos(20.0));
+    EXPECT_EQ(static_cast<std::size_t>(gone) + hair.positions.size(), before);
+    std::size_t kept40 = 0;
+    for (const auto& p : hair.positions) {
+        // Below the photos' hair, with the share's spread and the strands' smoothing, no hair is left.
+        EXPECT_GT(p.y, 5.0) << p.x << " " << p.y << " " << p.z;
+        kept40 += p.y > 40.0;
+    }
+    EXPECT_EQ(kept40, over40) << "the hair the photos show stays";
+    for (const auto& t : hair.triangles)
+        for (int k = 0; k < 3; ++k) EXPECT_LT(t[k], hair.positions.size());
+}
+
+TEST(HairPart, AStrandCardCutInPartGoesWhole) {
+    const Mesh head = sphere(90.0, -200.0);
+    // A card of 3 x 4 vertices hanging down the back from y 40 to -20, 2 mm off the scalp: its lower end is on skin.
+    Mesh card;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 3; ++c) {
+            const double y = 40.0 - 20.0 * r, x = -5.0 + 5.0 * c;
+            card.positions.emplace_back(x, y, -std::sqrt(92.0 * 92.0 - x * x - y * y));
+        }
+    for (std::uint32_t r = 0; r < 3; ++r)
+        for (std::uint32_t c = 0; c < 2; ++c) {
+            const std::uint32_t a = 3 * r + c;
+            card.triangles.emplace_back(a, a + 3, a + 4);
+            card.triangles.emplace_back(a, a + 4, a + 1);
+        }
+    EXPECT_EQ(trimShortHairToPhotos(card, head, roundHeadPhotos(20.0)), 12);
+    EXPECT_TRUE(card.positions.empty());
+    EXPECT_TRUE(card.triangles.empty());
+}
+
+TEST(HairPart, WithoutThePhotosMasksTheShortHairIsKeptAndBadMasksAreAnInternalError) {
+    const Mesh head = sphere(90.0, -200.0);
+    Mesh hair = sphere(91.5, -60.0);
+    const Mesh original = hair;
+    HairPhotoMasks none = roundHeadPhotos(20.0);
+    none.sideHair = cv::Mat();
+    EXPECT_EQ(trimShortHairToPhotos(hair, head, none), 0);
+    EXPECT_EQ(hair.positions.size(), original.positions.size());
+    HairPhotoMasks wrong = roundHeadPhotos(20.0);
+    wrong.frontHair.convertTo(wrong.frontHair, CV_32F);
+    try {
+        trimShortHairToPhotos(hair, head, wrong);
+        FAIL() << "a float mask was taken";
+    } catch (const BoothError& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::Internal);
+    }
 }

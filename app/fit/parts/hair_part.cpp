@@ -7,12 +7,15 @@
 #include "fit/parts/avatar_parts.h"
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
+#include <map>
 #include <optional>
 #include <utility>
 #include <string>
@@ -51,6 +54,142 @@ void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, con
         const double kept = clearance.depth * (1.0 - std::exp(-ahead / clearance.depth));
         p.z -= t * t * (3.0 - 2.0 * t) * (ahead - kept);
     }
+}
+
+namespace {
+
+// 1 where the photo shows hair (grown by `grow` pixels) or no person (it says nothing of hair there), 0 on the
+// person's skin and clothes, blurred by `sigma` pixels.
+cv::Mat hairOrUnknownShare(const cv::Mat& hair, const cv::Mat& person, int grow, double sigma) {
+    cv::Mat keep;
+    cv::dilate(hair, keep, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * grow + 1, 2 * grow + 1)));
+    keep.setTo(255, person == 0);
+    cv::Mat share;
+    keep.convertTo(share, CV_32F, 1.0 / 255.0);
+    cv::GaussianBlur(share, share, cv::Size(), sigma, sigma, cv::BORDER_REPLICATE);
+    return share;
+}
+
+// The nearest of a set of points within `reach` of a query (a grid of reach-sized cells).
+class NearestVertex {
+public:
+    NearestVertex(const std::vector<glm::dvec3>& points, double reach) : points_(points), reach_(reach) {
+        for (std::uint32_t v = 0; v < points.size(); ++v) cells_[cellOf(points[v])].push_back(v);
+    }
+    std::optional<std::uint32_t> operator()(const glm::dvec3& p) const {
+        const auto c = cellOf(p);
+        std::optional<std::uint32_t> nearest;
+        double best = reach_;
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz) {
+                    const auto it = cells_.find({c[0] + dx, c[1] + dy, c[2] + dz});
+                    if (it == cells_.end()) continue;
+                    for (const auto v : it->second) {
+                        const double d = glm::distance(p, points_[v]);
+                        if (d <= best) best = d, nearest = v;
+                    }
+                }
+        return nearest;
+    }
+
+private:
+    std::array<int, 3> cellOf(const glm::dvec3& p) const {
+        return {static_cast<int>(std::floor(p.x / reach_)), static_cast<int>(std::floor(p.y / reach_)),
+                static_cast<int>(std::floor(p.z / reach_))};
+    }
+    const std::vector<glm::dvec3>& points_;
+    double reach_;
+    std::map<std::array<int, 3>, std::vector<std::uint32_t>> cells_;
+};
+
+double sampleShare(const cv::Mat& share, const cv::Point2d& px) {
+    const int x = static_cast<int>(std::lround(px.x)), y = static_cast<int>(std::lround(px.y));
+    if (x < 0 || y < 0 || x >= share.cols || y >= share.rows) return 1.0;
+    return static_cast<double>(share.at<float>(y, x));
+}
+
+}  // namespace
+
+int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMasks& photos, const HairTrim& trim) {
+    const auto checked = [](const cv::Mat& hairMask, const cv::Mat& person, const char* which) {
+        if (hairMask.empty() || person.empty()) return false;
+        if (hairMask.type() != CV_8U || person.type() != CV_8U || hairMask.size() != person.size())
+            throw BoothError(ErrorKind::Internal, "hair part",
+                             std::string("trimShortHairToPhotos: the ") + which + " photo's masks are not CV_8U of one size");
+        return true;
+    };
+    if (!checked(photos.frontHair, photos.frontPerson, "front") || !checked(photos.sideHair, photos.sidePerson, "side") ||
+        photos.front.mmPerPixel <= 0.0 || photos.side.mmPerPixel <= 0.0 || fittedHead.positions.empty())
+        return 0;
+    const auto shareOf = [&](const cv::Mat& h, const cv::Mat& person, const PhotoFrame& frame) {
+        return hairOrUnknownShare(h, person, static_cast<int>(std::lround(trim.lenient / frame.mmPerPixel)),
+                                  std::max(0.5, trim.spread / frame.mmPerPixel));
+    };
+    const cv::Mat frontShare = shareOf(photos.frontHair, photos.frontPerson, photos.front);
+    const cv::Mat sideShare = shareOf(photos.sideHair, photos.sidePerson, photos.side);
+    const std::vector<glm::dvec3> normals = fittedHead.vertexNormals();
+    const NearestVertex nearestOnHead(fittedHead.positions, trim.reach);
+
+    // Each hair vertex's share of skin round its spot on the head (0 for the crown and for hair hanging free).
+    std::vector<double> skin(hair.positions.size(), 0.0);
+    for (std::size_t i = 0; i < hair.positions.size(); ++i) {
+        const auto spot = nearestOnHead(hair.positions[i]);
+        if (!spot) continue;
+        const glm::dvec3& q = fittedHead.positions[*spot];
+        const glm::dvec3& n = normals[*spot];
+        if (n.y > 0.85) continue;  // the crown: both photos see it edge-on
+        // The photo that sees the spot most squarely, read a little inside its outline where it sees it edge-on.
+        double share = 1.0;
+        if (n.z > std::abs(n.x)) {
+            const glm::dvec3 at = q - trim.inside * glm::dvec3(n.x, n.y, 0.0);
+            share = sampleShare(frontShare, photos.front.toPixel({at.x, at.y}));
+        } else {
+            const glm::dvec3 at = q - trim.inside * glm::dvec3(0.0, n.y, n.z);
+            share = sampleShare(sideShare, photos.side.toPixel({at.z, at.y}));
+        }
+        skin[i] = std::clamp((0.7 - share) / 0.4, 0.0, 1.0);  // from none at a share of 0.7 to all at 0.3
+    }
+    // Strands go with their neighbours along the hair's surface: a lone vertex kept among cut ones (a pixel of
+    // shade taken for hair) stood out as a stray wisp.
+    std::vector<std::vector<std::uint32_t>> neighbours(hair.positions.size());
+    for (const glm::uvec3& t : hair.triangles)
+        for (int k = 0; k < 3; ++k) {
+            neighbours[t[k]].push_back(t[(k + 1) % 3]);
+            neighbours[t[k]].push_back(t[(k + 2) % 3]);
+        }
+    for (int round = 0; round < trim.smoothRounds; ++round) {
+        std::vector<double> next(skin.size());
+        for (std::size_t i = 0; i < skin.size(); ++i) {
+            double sum = skin[i];
+            for (const auto j : neighbours[i]) sum += skin[j];
+            next[i] = sum / static_cast<double>(neighbours[i].size() + 1);
+        }
+        skin.swap(next);
+    }
+    // A strand card (a small connected piece of the hair's mesh) that is cut at all goes whole: cut in part, its
+    // rest stood out of the skin as slivers (FRMDB 003's fade).
+    std::vector<std::uint32_t> piece(hair.positions.size());
+    for (std::uint32_t i = 0; i < piece.size(); ++i) piece[i] = i;
+    const std::function<std::uint32_t(std::uint32_t)> root = [&](std::uint32_t i) {
+        while (piece[i] != i) i = piece[i] = piece[piece[i]];
+        return i;
+    };
+    for (const glm::uvec3& t : hair.triangles)
+        for (int k = 1; k < 3; ++k) piece[root(t[k])] = root(t[0]);
+    std::map<std::uint32_t, std::pair<int, int>> cutOfPiece;  // per piece: vertices cut, vertices
+    for (std::uint32_t i = 0; i < hair.positions.size(); ++i) {
+        auto& [cut, total] = cutOfPiece[root(i)];
+        cut += skin[i] > trim.cut;
+        ++total;
+    }
+    std::vector<std::uint32_t> trimmed;
+    for (std::uint32_t i = 0; i < hair.positions.size(); ++i) {
+        const auto& [cut, total] = cutOfPiece[root(i)];
+        if (skin[i] > trim.cut || (total <= trim.cardVertices && cut > 0)) trimmed.push_back(i);
+    }
+    if (!trimmed.empty()) hair = withoutVertices(hair, trimmed);
+    return static_cast<int>(trimmed.size());
 }
 
 double foreheadShownMm(const cv::Mat& hair, const std::array<cv::Point2d, 68>& points, const PhotoFrame& front,

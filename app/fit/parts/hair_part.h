@@ -106,6 +106,31 @@ std::vector<HairStretch> fitHairToSilhouettes(Mesh& hair, const Mesh& fittedHead
                                               const cv::Mat& frontMask, const PhotoFrame& side, const cv::Mat& sideMask,
                                               double chinY, const HairSilhouetteFit& options = {});
 
+// What the photos show of the hair (hairPixels: CV_8U, 255 on hair, in each photo as taken, with its person mask)
+// and how their pixels map to the head (the fit's frames).
+struct HairPhotoMasks {
+    cv::Mat frontHair, frontPerson, sideHair, sidePerson;
+    PhotoFrame front, side;
+};
+
+// How short hair is trimmed to the photos (trimShortHairToPhotos), in millimetres.
+struct HairTrim {
+    double lenient = 1.0;    // the photo's hair is grown by this first: a strand at the hair's edge stays
+    double spread = 2.0;     // the share of skin round a spot is taken over a Gaussian of this deviation
+    double inside = 2.0;     // a spot the photo sees edge-on is read this far inside its outline
+    double reach = 16.0;     // hair farther than this from the head hangs free and is kept
+    int smoothRounds = 4;    // the share of skin averaged over each hair vertex's neighbours this many times
+    double cut = 0.5;        // a vertex whose share of skin is over this goes, with its triangles
+    int cardVertices = 100;  // a connected piece of the hair this small is a strand card: cut at all, it goes whole
+};
+
+// MakeHuman's short04 is one haircut; visitors' are shorter at the sides (a fade), the temples or the nape. Each
+// vertex of the hair part is looked at in the photo that sees its spot on the head most squarely (the front photo
+// for the face's side of the head, the side photo, mirrored for the other side, for the sides and the back; the
+// crown is kept): where that photo shows the person's skin rather than hair round the spot, the vertex goes with its
+// triangles. `fittedHead`: the head the hair was placed on. Returns how many vertices went.
+int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMasks& photos, const HairTrim& trim = {});
+
 // The colour to paint hair with so that it shows `seen` (the photo's, BGR 0..255) under the booth's lights: the
 // lights show hair, which wraps round the head, at booth_lights::meanLightSeenOnSphere() (0.75) of its colour on
 // average (the README gives what the synthetic visitors' photos showed of theirs).
