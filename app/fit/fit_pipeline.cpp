@@ -233,7 +233,8 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         if (out.hair.style == HairStyle::Bob) clear.above = foreheadShownMm(m.frontHair, out.frontLandmarks.points, out.fit.front);
         out.foreheadShownMm = clear.above;
         keepFaceClear(hair->mesh, base_, out.fit.mesh, clear);
-        if (out.hair.style == HairStyle::Short && settings_.trimShortHair) {
+        if (out.hair.style == HairStyle::Short && settings_.trimShortHair &&
+            cv::norm(out.hair.hairLab - out.hair.skinLab) >= kTrimMinHairSkinContrast) {
             HairPhotoMasks masks{hairPixels(front, out.frontMask, out.hair), out.frontMask, hairPixels(side, out.sideMask, out.hair),
                                  out.sideMask, out.fit.front, out.fit.side};
             out.hairTrimmedVertices = trimShortHairToPhotos(hair->mesh, out.fit.mesh, masks);

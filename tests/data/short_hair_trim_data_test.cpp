@@ -137,7 +137,7 @@ TEST(ShortHairTrim, TheHairPartCoversTheScalpThePhotosShowHaired) {
     MeshRenderer renderer;
     std::vector<double> before, after;
     int worse = 0;
-    std::printf("%4s  %-9s %7s %7s\n", "seed", "hair", "untrim", "trimmed");
+    std::printf("%4s  %-15s %7s %7s %6s\n", "seed", "hair", "untrim", "trimmed", "dE h/s");
     for (unsigned seed = 1; seed <= kShortHairPeople; ++seed) {
         MakeHumanVisitorOptions options;
         options.seed = seed;
@@ -155,9 +155,10 @@ TEST(ShortHairTrim, TheHairPartCoversTheScalpThePhotosShowHaired) {
             before.push_back(b);
             after.push_back(a);
             worse += a < b - 0.02;
-            std::printf("%4u  %-9s %7.3f %7.3f\n", seed, person.person.hair.c_str(), b, a);
+            std::printf("%4u  %-15s %7.3f %7.3f %6.1f\n", seed, person.person.hair.c_str(), b, a,
+                        cv::norm(withTrim.hair.hairLab - withTrim.hair.skinLab));
         } catch (const BoothError& e) {
-            std::printf("%4u  %-9s refused: %s\n", seed, person.person.hair.c_str(), e.what());
+            std::printf("%4u  %-15s refused: %s\n", seed, person.person.hair.c_str(), e.what());
         }
     }
     std::printf("short hair over the painted cut (IoU of the head's vertices), median over %zu people: untrimmed "
@@ -165,5 +166,7 @@ TEST(ShortHairTrim, TheHairPartCoversTheScalpThePhotosShowHaired) {
                 after.size(), median(before), median(after), worse);
     ASSERT_GE(after.size(), 15u);
     EXPECT_GT(median(after), median(before) + 0.05);
-    EXPECT_LE(worse, static_cast<int>(after.size()) / 6);
+    // Measured 2026-12-05: 0 worse (the blond 9, 28 and 46, whose light hair the colour model took partly for skin,
+    // were, until kTrimMinHairSkinContrast left them their short04 whole).
+    EXPECT_LE(worse, 2);
 }

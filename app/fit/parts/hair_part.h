@@ -131,6 +131,11 @@ struct HairTrim {
 // triangles. `fittedHead`: the head the hair was placed on. Returns how many vertices went.
 int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMasks& photos, const HairTrim& trim = {});
 
+// The trim reads the photos' hair by colour (hairPixels): with the hair's colour this near the skin's (CIE L*a*b*
+// distance of the estimate's models) light hair at the hairline reads as skin, and the fit leaves short04 whole
+// (the blond of the short-hair test came out worse trimmed, at 24-28; everyone else is over 32).
+inline constexpr double kTrimMinHairSkinContrast = 29.0;
+
 // The colour to paint hair with so that it shows `seen` (the photo's, BGR 0..255) under the booth's lights: the
 // lights show hair, which wraps round the head, at booth_lights::meanLightSeenOnSphere() (0.75) of its colour on
 // average (the README gives what the synthetic visitors' photos showed of theirs).
