@@ -18,7 +18,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <vector>
 
 using namespace avatarbooth;
@@ -27,8 +26,8 @@ using avatarbooth::test::median;
 namespace {
 
 constexpr unsigned kShortHairPeople = 60;
-// A head vertex is under the avatar's hair when a vertex of the hair part lies this near it (short04 lies within
-// about 2 mm of the scalp; its cards' vertices are a few millimetres apart).
+// A head vertex is under the avatar's hair when the hair part's surface lies this near it (short04 lies within about
+// 2 mm of the scalp, its strand cards layered over it).
 constexpr double kCoveredMm = 6.0;
 
 cv::Vec3d paintAt(const cv::Mat& texture, const glm::dvec2& uv) {

@@ -13,7 +13,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
@@ -171,7 +170,7 @@ int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMas
     // rest stood out of the skin as slivers (FRMDB 003's fade).
     std::vector<std::uint32_t> piece(hair.positions.size());
     for (std::uint32_t i = 0; i < piece.size(); ++i) piece[i] = i;
-    const std::function<std::uint32_t(std::uint32_t)> root = [&](std::uint32_t i) {
+    const auto root = [&](std::uint32_t i) {
         while (piece[i] != i) i = piece[i] = piece[piece[i]];
         return i;
     };
