@@ -61,6 +61,9 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
     report["measured_extents"] = {o.fit.measuredExtents.x, o.fit.measuredExtents.y, o.fit.measuredExtents.z};
     report["mm_per_pixel"] = {{"front", o.fit.front.mmPerPixel}, {"side", o.fit.side.mmPerPixel}};
     report["texture_seen_fraction"] = o.texture.seenFraction;
+    // B, G, R, as the side photo's colours were scaled to the front's exposure (1 when too little skin was seen).
+    report["texture_side_gain"] = {o.texture.sideGain[0], o.texture.sideGain[1], o.texture.sideGain[2]};
+    report["texture_side_gain_texels"] = o.texture.sideGainTexels;
     report["model_load_seconds"] = o.modelLoadSeconds;
     nlohmann::json stages = nlohmann::json::array();
     double total = 0.0;

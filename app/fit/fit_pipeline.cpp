@@ -210,9 +210,14 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     for (const auto& w : out.fit.warnings) out.warnings.push_back(w);
     for (const auto* features : {&base_.frontFeatures, &base_.sideFeatures})
         for (const auto& [name, v] : *features) out.featurePoints.emplace_back(name, out.fit.mesh.positions[v]);
+    // The photos' hair, for the texture's exposure match (skin against skin) and the short hair's trim.
+    if (out.hair.style != HairStyle::None && m.frontHair.empty()) {
+        m.frontHair = hairPixels(front, out.frontMask, out.hair);
+        m.sideHair = hairPixels(side, out.sideMask, out.hair);
+    }
     out.texture = runStep(out, control, FitStep::Texture, names, [&] {
         return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture,
-                                 *textureTables_);
+                                 *textureTables_, ColourMatchMasks{m.frontHair, m.sideHair});
     });
     out.partColours = measurePartColours(front, out.frontLandmarks);
     out.parts = placeParts(base_, out.fit.mesh, out.texture.texture, out.partColours);
@@ -235,8 +240,7 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         keepFaceClear(hair->mesh, base_, out.fit.mesh, clear);
         if (out.hair.style == HairStyle::Short && settings_.trimShortHair &&
             cv::norm(out.hair.hairLab - out.hair.skinLab) >= kTrimMinHairSkinContrast) {
-            HairPhotoMasks masks{hairPixels(front, out.frontMask, out.hair), out.frontMask, hairPixels(side, out.sideMask, out.hair),
-                                 out.sideMask, out.fit.front, out.fit.side};
+            HairPhotoMasks masks{m.frontHair, out.frontMask, m.sideHair, out.sideMask, out.fit.front, out.fit.side};
             out.hairTrimmedVertices = trimShortHairToPhotos(hair->mesh, out.fit.mesh, masks);
         }
         // The fitted head's ears stand out further than those MakeHuman's styles were made over.

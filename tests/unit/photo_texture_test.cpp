@@ -278,6 +278,46 @@ TEST(PhotoTexture, SeamIsBlendedWherePhotosDisagree) {
     EXPECT_LT(s.acrossSeam, 2.0 * s.withinFront + 1.0);
 }
 
+// The side photo is taken at another exposure and white balance (its channels at 0.8, 0.9 and 1.1 of the front's),
+// and in the front photo dark hair falls over the upper half of the band both photos see (as long hair falls over
+// the temples and cheeks and lies behind them in the profile). The gain is measured on the skin both photos see, the
+// hair left out by the not-skin mask: it undoes the exposure. Compared with the hair, it would not.
+TEST(PhotoTexture, SidePhotosExposureIsMatchedOnSkinNotOnHair) {
+    const Mesh sphere = uvSphere(kRadius);
+    const HeadFit fit = photoFrames();
+    cv::Mat frontMask, sideMask;
+    const auto same = [](const glm::dvec3&) { return 1.0; };
+    cv::Mat front = spherePhoto(fit, false, frontMask, same), side = spherePhoto(fit, true, sideMask, same);
+    const cv::Vec3d exposure(0.8, 0.9, 1.1);
+    cv::multiply(side, cv::Scalar(exposure[0], exposure[1], exposure[2]), side);
+    cv::Mat frontHair(front.size(), CV_8U, cv::Scalar(0));
+    for (int v = 0; v < front.rows; ++v)
+        for (int u = 0; u < front.cols; ++u) {
+            const glm::dvec2 q = fit.front.toHead(cv::Point2d(u, v));
+            // The side camera looks from -x: the band both see lies at x < -0.4 r on the front photo.
+            if (frontMask.at<unsigned char>(v, u) && q.x < -0.3 * kRadius && q.y > 0.0) {
+                front.at<cv::Vec3b>(v, u) = cv::Vec3b(25, 30, 40);
+                frontHair.at<unsigned char>(v, u) = 255;
+            }
+        }
+    PhotoTextureOptions o;
+    o.size = 512;
+    const PhotoTexture masked = textureFromPhotos(sphere, fit, front, frontMask, side, sideMask, o, ColourMatchMasks{frontHair, {}});
+    const PhotoTexture unmasked = textureFromPhotos(sphere, fit, front, frontMask, side, sideMask, o);
+    std::printf("side gain on skin %.3f %.3f %.3f (%d texels), with the hair %.3f %.3f %.3f; exposure undone by %.3f %.3f %.3f\n",
+                masked.sideGain[0], masked.sideGain[1], masked.sideGain[2], masked.sideGainTexels, unmasked.sideGain[0],
+                unmasked.sideGain[1], unmasked.sideGain[2], 1.0 / exposure[0], 1.0 / exposure[1], 1.0 / exposure[2]);
+    ASSERT_GT(masked.sideGainTexels, 500);
+    EXPECT_LT(masked.sideGainTexels, unmasked.sideGainTexels);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(masked.sideGain[c], 1.0 / exposure[c], 0.02) << "channel " << c;
+        EXPECT_GT(std::abs(unmasked.sideGain[c] - 1.0 / exposure[c]), 0.1) << "the hair should mislead an unmasked match, channel " << c;
+    }
+    // And the side photo's texels show the sphere's own colours again: no step at the seam.
+    const SeamStats s = seamStats(sphere, masked);
+    EXPECT_LT(s.acrossSeam, 2.0 * s.withinFront + 1.0);
+}
+
 // No photo sees the back of the sphere: it is filled from the colours around it, not left black.
 TEST(PhotoTexture, UnseenTexelsAreFilledWithSurroundingColours) {
     const Mesh sphere = uvSphere(kRadius);

@@ -35,6 +35,20 @@ struct PhotoTexture {
     // photo, 2 the side photo (either side of the head; mirrored for the side it did not see).
     cv::Mat source;     // CV_8U, size x size
     enum Source : unsigned char { Filled = 0, Front = 1, Side = 2 };
+    // The per-channel (B, G, R) gain the side photo's colours took to match the front photo's exposure and white
+    // balance, and how many half-resolution texels of skin both photos saw it was measured on (0: too few to
+    // measure, gain 1).
+    cv::Vec3f sideGain{1.0f, 1.0f, 1.0f};
+    int sideGainTexels = 0;
+};
+
+// Pixels of each photo that are not the visitor's skin (hair, a beard: hairPixels of the hair analysis), CV_8U of the
+// photo's size, non-zero where not skin; or empty. The side photo's exposure is matched to the front's on the
+// surface both photos see: where one of them shows hair there and the other skin (long hair falls over the front
+// photo's temples and cheeks and lies behind them in the side photo), comparing the two measures the hair, not the
+// exposure.
+struct ColourMatchMasks {
+    cv::Mat frontNotSkin, sideNotSkin;
 };
 
 // front/side: the photos as taken; the masks: their silhouettes. A texel takes a photo's colour only where that
@@ -67,10 +81,11 @@ private:
 // `tables`: made for the fitted mesh's base head and options.size (BoothError Internal otherwise).
 PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
                                const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options,
-                               const TextureTables& tables);
+                               const TextureTables& tables, const ColourMatchMasks& notSkin = {});
 // The same, making the tables for this one call.
 PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv::Mat& front, const cv::Mat& frontMask,
-                               const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options = {});
+                               const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options = {},
+                               const ColourMatchMasks& notSkin = {});
 
 // Where no photo saw the head (texels the fill made up: under the chin, in and behind the ears, parts of the top),
 // the base head's skin layer lends its detail (TextureTables::skinDetail, added by textureFromPhotos), so that ears,
