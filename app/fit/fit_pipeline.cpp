@@ -86,7 +86,13 @@ auto runStep(Out& out, const FitControl& control, FitStep step, const FitPhotoNa
 FitPipeline::FitPipeline(FitSettings settings, const BaseHead& base) : settings_(std::move(settings)), base_(base) {
     const auto t0 = Clock::now();
     detector_ = std::make_unique<LandmarkDetector>(settings_.landmarkModel);
-    textureTables_ = std::make_shared<const TextureTables>(base_.mesh, settings_.texture, base_.skin);
+    // The eyes' and brows' landmarks: the front photo registers them, the side photo lands there through the depth.
+    std::vector<std::uint32_t> eyesAndBrows;
+    for (int k = 17; k <= 47; ++k)
+        if (k <= 26 || k >= 36)
+            if (const auto it = base_.frontFeatures.find(landmarkName(k)); it != base_.frontFeatures.end())
+                eyesAndBrows.push_back(it->second);
+    textureTables_ = std::make_shared<const TextureTables>(base_.mesh, settings_.texture, base_.skin, eyesAndBrows);
     frontalCheck_ = std::make_shared<FrontalFaceCheck>();
     modelLoadSeconds_ = secondsSince(t0);
     // OpenCV fills its 8-bit CIELAB tables at the first such conversion (0.13 s of one core here), which the hair

@@ -318,6 +318,57 @@ TEST(PhotoTexture, SidePhotosExposureIsMatchedOnSkinNotOnHair) {
     EXPECT_LT(s.acrossSeam, 2.0 * s.withinFront + 1.0);
 }
 
+// The side photo shows a dark mark where the surface turns 70 degrees from the front (as a brow's tail lands on the
+// temple when the fitted depth there is a few millimetres off); the front photo shows the sphere's own colour. By
+// default the side photo takes that surface (beyond about 63 degrees). With a front feature vertex beside it, the
+// front photo is preferred there (up to about 81 degrees) and the mark is gone.
+TEST(PhotoTexture, FrontPhotoIsPreferredRoundFrontFeatures) {
+    const Mesh sphere = uvSphere(kRadius);
+    const HeadFit fit = photoFrames();
+    cv::Mat frontMask, sideMask;
+    const auto same = [](const glm::dvec3&) { return 1.0; };
+    const double yaw = 70.0 * kPi / 180.0;
+    const glm::dvec3 spot(-kRadius * std::sin(yaw), 0.0, kRadius * std::cos(yaw));
+    // In the side photo (seen from -x), a pixel's head coordinates are (z, y).
+    const auto marked = [&](const glm::dvec3& p) { return glm::distance(p, spot) < 8.0 ? 0.15 : 1.0; };
+    const cv::Mat front = spherePhoto(fit, false, frontMask, same), side = spherePhoto(fit, true, sideMask, marked);
+    PhotoTextureOptions o;
+    o.size = 512;
+    std::uint32_t nearest = 0;
+    for (std::uint32_t v = 0; v < sphere.positions.size(); ++v)
+        if (glm::distance(sphere.positions[v], spot) < glm::distance(sphere.positions[nearest], spot)) nearest = v;
+    const PhotoTexture plain = textureFromPhotos(sphere, fit, front, frontMask, side, sideMask, o, TextureTables(sphere, o));
+    const PhotoTexture preferred =
+        textureFromPhotos(sphere, fit, front, frontMask, side, sideMask, o, TextureTables(sphere, o, {}, {nearest}));
+
+    // The texture round the spot against the sphere's own colours there.
+    const SurfaceTexels texels = sampleSurfaceTexels(sphere, sphere.vertexNormals(), cv::Size(o.size, o.size));
+    const auto errorAtSpot = [&](const PhotoTexture& t, int& source) {
+        double error = 0.0;
+        int n = 0, fromFront = 0;
+        for (int y = 0; y < o.size; ++y)
+            for (int x = 0; x < o.size; ++x) {
+                if (!texels.covered.at<unsigned char>(y, x)) continue;
+                const cv::Vec3f q = texels.position.at<cv::Vec3f>(y, x);
+                const glm::dvec3 p(q[0], q[1], q[2]);
+                if (glm::distance(p, spot) > 4.0) continue;
+                error += cv::norm(cv::Vec3d(t.texture.at<cv::Vec3b>(y, x)) - sphereColour(p)) / std::sqrt(3.0);
+                fromFront += t.source.at<unsigned char>(y, x) == PhotoTexture::Front ? 1 : 0;
+                ++n;
+            }
+        source = n > 0 ? 100 * fromFront / n : 0;
+        return error / std::max(n, 1);
+    };
+    int plainFront = 0, preferredFront = 0;
+    const double plainError = errorAtSpot(plain, plainFront), preferredError = errorAtSpot(preferred, preferredFront);
+    std::printf("at 70 degrees: %d %% from the front photo, error %.1f; with a front feature beside it %d %%, error %.1f\n",
+                plainFront, plainError, preferredFront, preferredError);
+    EXPECT_EQ(plainFront, 0);
+    EXPECT_GT(plainError, 40.0) << "the side photo's mark should show without the preference";
+    EXPECT_EQ(preferredFront, 100);
+    EXPECT_LT(preferredError, 6.0);
+}
+
 // No photo sees the back of the sphere: it is filled from the colours around it, not left black.
 TEST(PhotoTexture, UnseenTexelsAreFilledWithSurroundingColours) {
     const Mesh sphere = uvSphere(kRadius);

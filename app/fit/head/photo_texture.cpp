@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace avatarbooth {
 
@@ -274,10 +275,25 @@ const Mesh& withUvs(const Mesh& mesh) {
 
 }  // namespace
 
-TextureTables::TextureTables(const Mesh& base, const PhotoTextureOptions& options, const cv::Mat& skin)
+TextureTables::TextureTables(const Mesh& base, const PhotoTextureOptions& options, const cv::Mat& skin,
+                             const std::vector<std::uint32_t>& frontFeatures)
     : vertices_(withUvs(base).uvs.size()), triangles_(base.triangles.size()),
       full_(mapTexels(base, cv::Size(checkedTextureSize(options), options.size))),
       half_(mapTexels(base, cv::Size((options.size + 1) / 2, (options.size + 1) / 2))) {
+    if (!frontFeatures.empty()) {
+        frontPreference_.resize(base.positions.size());
+        for (std::size_t v = 0; v < base.positions.size(); ++v) {
+            double nearest = std::numeric_limits<double>::infinity();
+            for (const std::uint32_t f : frontFeatures) {
+                if (f >= base.positions.size())
+                    throw BoothError(ErrorKind::Internal, "", "texture: a front feature vertex is not on the base head");
+                nearest = std::min(nearest, glm::distance(base.positions[v], base.positions[f]));
+            }
+            const double t = std::clamp((nearest - options.featureReachMm) / std::max(options.featureFadeMm, 1e-9), 0.0, 1.0);
+            frontPreference_[v] = static_cast<float>(options.featureFrontPreference +
+                                                     (options.frontPreference - options.featureFrontPreference) * t);
+        }
+    }
     if (skin.empty()) return;
     // The skin layer's detail: its difference from its own blur (finer than about 1/40 of the texture: a crease, an
     // ear's fold), made once here because the wide blur is the costly part.
@@ -350,7 +366,8 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
         v.cosSide = static_cast<float>(n.x);
         v.tolFront = tolerance(n.z, fit.front.mmPerPixel);
         v.tolSide = tolerance(n.x, fit.side.mmPerPixel);
-        v.frontBetter = static_cast<float>(options.frontPreference * weightOf(m.z) - weightOf(std::abs(m.x)));
+        const double preference = tables.frontPreference().empty() ? options.frontPreference : tables.frontPreference()[i];
+        v.frontBetter = static_cast<float>(preference * weightOf(m.z) - weightOf(std::abs(m.x)));
         depthVertices[0][i] = {v.fu, v.fv, v.z};
         depthVertices[1][i] = {v.su, v.sv, -v.x};
         depthVertices[2][i] = {v.su, v.sv, v.x};

@@ -8,6 +8,9 @@
 
 #include <opencv2/core.hpp>
 
+#include <cstdint>
+#include <vector>
+
 namespace avatarbooth {
 
 struct PhotoTextureOptions {
@@ -21,6 +24,15 @@ struct PhotoTextureOptions {
     // photo's colour lands through the fitted depth z, which off the profile line is the base head's guess, so on
     // the face (cheeks by the nose and mouth) it is the less trustworthy of the two.
     double frontPreference = 4.0;
+    // Round the eyes and brows (TextureTables' front features) the front photo is preferred more: there the side
+    // photo lands through the fitted depth of the eye's corner and the brow's tail, and a few millimetres off it put
+    // a second brow tail and eye corner onto the temple (FRMDB 001, 002, 003). With 40 the side photo takes over
+    // only where the surface turns more than about 81 degrees from the front (16, 76 degrees, left a fainter ghost of
+    // 003's eye corner). Full within featureReachMm of a feature vertex, fading to frontPreference over the next
+    // featureFadeMm.
+    double featureFrontPreference = 40.0;
+    double featureReachMm = 25.0;
+    double featureFadeMm = 15.0;
     // Bands of the multi-band blend across the seam (more = a wider, softer transition of the low frequencies): the
     // finest switches at the seam at full resolution, the others are OpenCV's MultiBandBlender at half resolution.
     int blendBands = 5;
@@ -62,8 +74,11 @@ struct ColourMatchMasks {
 class TextureTables {
 public:
     // Throws BoothError(Internal) for a size under 16 texels.
-    // `skin`: the base head's skin layer on its UVs (BaseHead::skin), or empty.
-    TextureTables(const Mesh& base, const PhotoTextureOptions& options, const cv::Mat& skin = {});
+    // `skin`: the base head's skin layer on its UVs (BaseHead::skin), or empty. `frontFeatures`: the base head's
+    // vertices whose place the front photo registers and the side photo does not (the eyes' and brows' landmarks),
+    // round which the front photo is preferred (PhotoTextureOptions::featureFrontPreference); or none.
+    TextureTables(const Mesh& base, const PhotoTextureOptions& options, const cv::Mat& skin = {},
+                  const std::vector<std::uint32_t>& frontFeatures = {});
     int size() const { return full_.size.width; }
     const TexelMap& full() const { return full_; }
     const TexelMap& half() const { return half_; }
@@ -71,11 +86,15 @@ public:
     bool fits(const Mesh& mesh) const { return mesh.uvs.size() == vertices_ && mesh.triangles.size() == triangles_; }
     // The skin layer's fine detail at the texture's size (CV_8SC3, levels), or empty: see addBaseLayerDetail.
     const cv::Mat& skinDetail() const { return skinDetail_; }
+    // Per vertex, how much the front photo is preferred (PhotoTextureOptions::frontPreference, more round the front
+    // features); empty when no features were given (frontPreference everywhere).
+    const std::vector<float>& frontPreference() const { return frontPreference_; }
 
 private:
     std::size_t vertices_, triangles_;
     TexelMap full_, half_;
     cv::Mat skinDetail_;
+    std::vector<float> frontPreference_;
 };
 
 // `tables`: made for the fitted mesh's base head and options.size (BoothError Internal otherwise).
