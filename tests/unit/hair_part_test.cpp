@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -340,6 +341,39 @@ TEST(HairPart, AStrandCardCutInPartGoesWhole) {
     EXPECT_EQ(trimShortHairToPhotos(card, head, roundHeadPhotos(20.0)), 12);
     EXPECT_TRUE(card.positions.empty());
     EXPECT_TRUE(card.triangles.empty());
+}
+
+// Photos showing hair all over the head: no spot reads as skin. Of two strand cards down the back, the one lying
+// 1 mm off the scalp stays; the one hanging straight down from 5 mm behind the head reaches out of the side
+// photo's outline (the head's disc) and goes whole.
+TEST(HairPart, AStrandCardReachingOutOfThePhotosOutlineGoesWhole) {
+    const Mesh head = sphere(90.0, -200.0);
+    Mesh cards;
+    const auto addCard = [&](const std::function<glm::dvec3(double x, int row)>& at) {
+        const auto base = static_cast<std::uint32_t>(cards.positions.size());
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 3; ++c) cards.positions.push_back(at(-5.0 + 5.0 * c, r));
+        for (std::uint32_t r = 0; r < 3; ++r)
+            for (std::uint32_t c = 0; c < 2; ++c) {
+                const std::uint32_t a = base + 3 * r + c;
+                cards.triangles.emplace_back(a, a + 3, a + 4);
+                cards.triangles.emplace_back(a, a + 4, a + 1);
+            }
+    };
+    addCard([](double x, int row) {  // on the scalp: y 40 to -20
+        const double y = 40.0 - 20.0 * row;
+        return glm::dvec3(x, y, -std::sqrt(91.0 * 91.0 - x * x - y * y));
+    });
+    addCard([](double x, int row) { return glm::dvec3(x, -25.0 * row, -95.0); });  // hanging free: y 0 to -75
+    Mesh withoutTheRule = cards;
+    HairTrim anywhere;
+    anywhere.outside = 1e9;
+    EXPECT_EQ(trimShortHairToPhotos(withoutTheRule, head, roundHeadPhotos(-100.0), anywhere), 0)
+        << "only the outline should take the hanging card";
+    EXPECT_EQ(trimShortHairToPhotos(cards, head, roundHeadPhotos(-100.0)), 12);
+    ASSERT_EQ(cards.positions.size(), 12u);
+    for (const auto& p : cards.positions) EXPECT_GT(p.y, -25.0) << "the card on the scalp stays";
+    EXPECT_EQ(cards.triangles.size(), 12u);
 }
 
 TEST(HairPart, WithoutThePhotosMasksTheShortHairIsKeptAndBadMasksAreAnInternalError) {

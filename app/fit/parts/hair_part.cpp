@@ -176,16 +176,35 @@ int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMas
     };
     for (const glm::uvec3& t : hair.triangles)
         for (int k = 1; k < 3; ++k) piece[root(t[k])] = root(t[0]);
-    std::map<std::uint32_t, std::pair<int, int>> cutOfPiece;  // per piece: vertices cut, vertices
+    // And a card that reaches out of either photo's outline goes: short hair lies inside the outlines (the head fit
+    // followed them, hair included), so a card out there hangs where the photos show no hair (short04's long card
+    // down the nape, hanging free of the head where the trim above does not look).
+    cv::Mat frontOff, sideOff;  // pixels off the person, to the nearest pixel on them
+    cv::distanceTransform(photos.frontPerson == 0, frontOff, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    cv::distanceTransform(photos.sidePerson == 0, sideOff, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    const auto outsideMm = [](const cv::Mat& off, const PhotoFrame& frame, const glm::dvec2& at) {
+        const cv::Point2d px = frame.toPixel(at);
+        const int x = static_cast<int>(std::lround(px.x)), y = static_cast<int>(std::lround(px.y));
+        if (x < 0 || y < 0 || x >= off.cols || y >= off.rows) return std::numeric_limits<double>::infinity();
+        return off.at<float>(y, x) * frame.mmPerPixel;
+    };
+    struct PieceCut {
+        int cut = 0, total = 0;
+        bool outside = false;
+    };
+    std::map<std::uint32_t, PieceCut> cutOfPiece;
     for (std::uint32_t i = 0; i < hair.positions.size(); ++i) {
-        auto& [cut, total] = cutOfPiece[root(i)];
-        cut += skin[i] > trim.cut;
-        ++total;
+        PieceCut& c = cutOfPiece[root(i)];
+        c.cut += skin[i] > trim.cut;
+        ++c.total;
+        const glm::dvec3& p = hair.positions[i];
+        c.outside = c.outside || outsideMm(frontOff, photos.front, {p.x, p.y}) > trim.outside ||
+                    outsideMm(sideOff, photos.side, {p.z, p.y}) > trim.outside;
     }
     std::vector<std::uint32_t> trimmed;
     for (std::uint32_t i = 0; i < hair.positions.size(); ++i) {
-        const auto& [cut, total] = cutOfPiece[root(i)];
-        if (skin[i] > trim.cut || (total <= trim.cardVertices && cut > 0)) trimmed.push_back(i);
+        const PieceCut& c = cutOfPiece[root(i)];
+        if (skin[i] > trim.cut || (c.total <= trim.cardVertices && (c.cut > 0 || c.outside))) trimmed.push_back(i);
     }
     if (!trimmed.empty()) hair = withoutVertices(hair, trimmed);
     return static_cast<int>(trimmed.size());

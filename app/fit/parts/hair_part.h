@@ -122,13 +122,15 @@ struct HairTrim {
     int smoothRounds = 4;    // the share of skin averaged over each hair vertex's neighbours this many times
     double cut = 0.5;        // a vertex whose share of skin is over this goes, with its triangles
     int cardVertices = 100;  // a connected piece of the hair this small is a strand card: cut at all, it goes whole
+    double outside = 2.0;    // a strand card reaching farther than this out of either photo's outline goes whole
 };
 
 // MakeHuman's short04 is one haircut; visitors' are shorter at the sides (a fade), the temples or the nape. Each
 // vertex of the hair part is looked at in the photo that sees its spot on the head most squarely (the front photo
 // for the face's side of the head, the side photo, mirrored for the other side, for the sides and the back; the
 // crown is kept): where that photo shows the person's skin rather than hair round the spot, the vertex goes with its
-// triangles. `fittedHead`: the head the hair was placed on. Returns how many vertices went.
+// triangles; and a strand card that reaches out of either photo's outline goes. `fittedHead`: the head the hair was
+// placed on. Returns how many vertices went.
 int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMasks& photos, const HairTrim& trim = {});
 
 // The trim reads the photos' hair by colour (hairPixels): with the hair's colour this near the skin's (CIE L*a*b*
