@@ -177,8 +177,8 @@ int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMas
     for (const glm::uvec3& t : hair.triangles)
         for (int k = 1; k < 3; ++k) piece[root(t[k])] = root(t[0]);
     // And a card that reaches out of either photo's outline goes: short hair lies inside the outlines (the head fit
-    // followed them, hair included), so a card out there hangs where the photos show no hair (short04's long card
-    // down the nape, hanging free of the head where the trim above does not look).
+    // followed them, hair included), so a card out there stands where the photos show no hair (FRMDB 002's over the
+    // nape and the temple, some hanging free of the head, where the trim above does not look).
     cv::Mat frontOff, sideOff;  // pixels off the person, to the nearest pixel on them
     cv::distanceTransform(photos.frontPerson == 0, frontOff, cv::DIST_L2, cv::DIST_MASK_PRECISE);
     cv::distanceTransform(photos.sidePerson == 0, sideOff, cv::DIST_L2, cv::DIST_MASK_PRECISE);
