@@ -294,7 +294,8 @@ TEST(PhotoTexture, SidePhotosExposureIsMatchedOnSkinNotOnHair) {
     for (int v = 0; v < front.rows; ++v)
         for (int u = 0; u < front.cols; ++u) {
             const glm::dvec2 q = fit.front.toHead(cv::Point2d(u, v));
-            // The side camera looks from -x: the band both see lies at x < -0.4 r on the front photo.
+            // The side camera looks from -x: the band both see lies at x < -0.4 r on the front photo; the hair reaches
+            // a little further in, as it does over a cheek.
             if (frontMask.at<unsigned char>(v, u) && q.x < -0.3 * kRadius && q.y > 0.0) {
                 front.at<cv::Vec3b>(v, u) = cv::Vec3b(25, 30, 40);
                 frontHair.at<unsigned char>(v, u) = 255;
@@ -329,7 +330,6 @@ TEST(PhotoTexture, FrontPhotoIsPreferredRoundFrontFeatures) {
     const auto same = [](const glm::dvec3&) { return 1.0; };
     const double yaw = 70.0 * kPi / 180.0;
     const glm::dvec3 spot(-kRadius * std::sin(yaw), 0.0, kRadius * std::cos(yaw));
-    // In the side photo (seen from -x), a pixel's head coordinates are (z, y).
     const auto marked = [&](const glm::dvec3& p) { return glm::distance(p, spot) < 8.0 ? 0.15 : 1.0; };
     const cv::Mat front = spherePhoto(fit, false, frontMask, same), side = spherePhoto(fit, true, sideMask, marked);
     PhotoTextureOptions o;

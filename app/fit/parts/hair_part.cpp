@@ -102,10 +102,11 @@ private:
     std::map<std::array<int, 3>, std::vector<std::uint32_t>> cells_;
 };
 
-double sampleShare(const cv::Mat& share, const cv::Point2d& px) {
+// A CV_32F image's value at the pixel nearest `px`, or `beyond` outside the image.
+double valueAt(const cv::Mat& image, const cv::Point2d& px, double beyond) {
     const int x = static_cast<int>(std::lround(px.x)), y = static_cast<int>(std::lround(px.y));
-    if (x < 0 || y < 0 || x >= share.cols || y >= share.rows) return 1.0;
-    return static_cast<double>(share.at<float>(y, x));
+    if (x < 0 || y < 0 || x >= image.cols || y >= image.rows) return beyond;
+    return static_cast<double>(image.at<float>(y, x));
 }
 
 }  // namespace
@@ -142,10 +143,10 @@ int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMas
         double share = 1.0;
         if (n.z > std::abs(n.x)) {
             const glm::dvec3 at = q - trim.inside * glm::dvec3(n.x, n.y, 0.0);
-            share = sampleShare(frontShare, photos.front.toPixel({at.x, at.y}));
+            share = valueAt(frontShare, photos.front.toPixel({at.x, at.y}), 1.0);
         } else {
             const glm::dvec3 at = q - trim.inside * glm::dvec3(0.0, n.y, n.z);
-            share = sampleShare(sideShare, photos.side.toPixel({at.z, at.y}));
+            share = valueAt(sideShare, photos.side.toPixel({at.z, at.y}), 1.0);
         }
         skin[i] = std::clamp((0.7 - share) / 0.4, 0.0, 1.0);  // from none at a share of 0.7 to all at 0.3
     }
@@ -183,10 +184,7 @@ int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMas
     cv::distanceTransform(photos.frontPerson == 0, frontOff, cv::DIST_L2, cv::DIST_MASK_PRECISE);
     cv::distanceTransform(photos.sidePerson == 0, sideOff, cv::DIST_L2, cv::DIST_MASK_PRECISE);
     const auto outsideMm = [](const cv::Mat& off, const PhotoFrame& frame, const glm::dvec2& at) {
-        const cv::Point2d px = frame.toPixel(at);
-        const int x = static_cast<int>(std::lround(px.x)), y = static_cast<int>(std::lround(px.y));
-        if (x < 0 || y < 0 || x >= off.cols || y >= off.rows) return std::numeric_limits<double>::infinity();
-        return off.at<float>(y, x) * frame.mmPerPixel;
+        return valueAt(off, frame.toPixel(at), std::numeric_limits<double>::infinity()) * frame.mmPerPixel;
     };
     struct PieceCut {
         int cut = 0, total = 0;
