@@ -10,7 +10,7 @@ namespace {
 
 using namespace std::chrono_literals;
 using E = TimelineEdge;
-const std::vector<std::string> kButtons{"start", "retake"};
+const std::vector<std::string> kTimelineButtons{"start", "retake"};
 constexpr std::size_t S = 0, R = 1;
 
 TEST(GpioTimeline, EveryKindOfLineExpandsToExactEdges) {
@@ -23,8 +23,8 @@ TEST(GpioTimeline, EveryKindOfLineExpandsToExactEdges) {
         "at 5s hold start+retake 3s\n"
         "at 10s tap start 50ms bounce 2\n"
         "at 0.2min press retake\n";
-    const ButtonTimeline t = parseButtonTimeline(script, "visit.timeline", kButtons);
-    EXPECT_EQ(t.buttons, kButtons);
+    const ButtonTimeline t = parseButtonTimeline(script, "visit.timeline", kTimelineButtons);
+    EXPECT_EQ(t.buttons, kTimelineButtons);
     const std::vector<E> expected{
         {2000ms, S, true, 2},    {2100ms, S, false, 3},   {3000ms, R, true, 5},    {3100ms, R, false, 5},
         {5000ms, S, true, 6},    {5000ms, R, true, 6},    {8000ms, S, false, 6},   {8000ms, R, false, 6},
@@ -36,14 +36,14 @@ TEST(GpioTimeline, EveryKindOfLineExpandsToExactEdges) {
 }
 
 TEST(GpioTimeline, EmptyAndCommentOnlyScriptsHaveNoEdges) {
-    EXPECT_TRUE(parseButtonTimeline("", "x", kButtons).edges.empty());
-    EXPECT_TRUE(parseButtonTimeline("# nothing\n\n   \n", "x", kButtons).edges.empty());
+    EXPECT_TRUE(parseButtonTimeline("", "x", kTimelineButtons).edges.empty());
+    EXPECT_TRUE(parseButtonTimeline("# nothing\n\n   \n", "x", kTimelineButtons).edges.empty());
 }
 
 // The error for `script`, which must be BadConfig.
 std::string timelineErrorOf(const std::string& script) {
     try {
-        parseButtonTimeline(script, "s.timeline", kButtons);
+        parseButtonTimeline(script, "s.timeline", kTimelineButtons);
     } catch (const BoothError& e) {
         EXPECT_EQ(e.kind(), ErrorKind::BadConfig);
         return e.what();
