@@ -65,6 +65,10 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
     report["texture_side_gain"] = {o.texture.sideGain[0], o.texture.sideGain[1], o.texture.sideGain[2]};
     report["texture_side_gain_texels"] = o.texture.sideGainTexels;
     report["model_load_seconds"] = o.modelLoadSeconds;
+    report["side_ear"] = {{"found", o.sideEar.found}, {"centre_px", {o.sideEar.centre.x, o.sideEar.centre.y}},
+                          {"score", o.sideEar.score}, {"scale", o.sideEar.scale},
+                          {"placed", o.fit.earsPlaced}, {"offset_mm", {o.fit.earOffsetMm.x, o.fit.earOffsetMm.y}},
+                          {"shift_mm", {o.fit.earShiftMm.x, o.fit.earShiftMm.y}}};
     nlohmann::json stages = nlohmann::json::array();
     double total = 0.0;
     for (const auto& [name, seconds] : o.stageSeconds) {

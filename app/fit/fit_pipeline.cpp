@@ -8,6 +8,7 @@
 #include "common/image_io.h"
 #include "fit/face/profile.h"
 #include "fit/face/silhouette.h"
+#include "fit/head/ears.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -94,6 +95,7 @@ FitPipeline::FitPipeline(FitSettings settings, const BaseHead& base) : settings_
                 eyesAndBrows.push_back(it->second);
     textureTables_ = std::make_shared<const TextureTables>(base_.mesh, settings_.texture, base_.skin, eyesAndBrows);
     frontalCheck_ = std::make_shared<FrontalFaceCheck>();
+    earTemplate_ = std::make_shared<const EarTemplate>(makeEarTemplate(base_));
     modelLoadSeconds_ = secondsSince(t0);
     // OpenCV fills its 8-bit CIELAB tables at the first such conversion (0.13 s of one core here), which the hair
     // analysis makes: here, while the kiosk's attract screen runs, not in the first visitor's fit (and not counted
@@ -104,7 +106,7 @@ FitPipeline::FitPipeline(FitSettings settings, const BaseHead& base) : settings_
 
 FitPipeline::FitPipeline(const FitPipeline& shareFrom, std::unique_ptr<LandmarkDetector> detector)
     : settings_(shareFrom.settings_), base_(shareFrom.base_), detector_(std::move(detector)),
-      textureTables_(shareFrom.textureTables_), frontalCheck_(shareFrom.frontalCheck_),
+      textureTables_(shareFrom.textureTables_), frontalCheck_(shareFrom.frontalCheck_), earTemplate_(shareFrom.earTemplate_),
       modelLoadSeconds_(shareFrom.modelLoadSeconds_) {}
 
 FitPipeline::~FitPipeline() = default;
@@ -211,16 +213,22 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
             out.hair = HairEstimate{};
             out.warnings.push_back(std::string("hair analysis: ") + e.what());
         }
+        {
+            std::vector<ProfilePoint> profile;
+            for (const auto& [name, px] : out.sideLandmarks) profile.push_back({name, px});
+            // (The side photo's hair pixels count in the head fit only with big hair; the texture takes them too.)
+            if (m.sideHair.empty() && out.hair.style != HairStyle::None) m.sideHair = hairPixels(side, out.sideMask, out.hair);
+            out.sideEar = locateEar(side, out.sideMask, m.sideHair, profile, out.sideNoseImageRight, *earTemplate_);
+            if (out.sideEar.found) m.sideEar = out.sideEar.centre;
+        }
         return fitHead(base_, m, head);
     });
     for (const auto& w : out.fit.warnings) out.warnings.push_back(w);
     for (const auto* features : {&base_.frontFeatures, &base_.sideFeatures})
         for (const auto& [name, v] : *features) out.featurePoints.emplace_back(name, out.fit.mesh.positions[v]);
     // The photos' hair, for the texture's exposure match (skin against skin) and the short hair's trim.
-    if (out.hair.style != HairStyle::None && m.frontHair.empty()) {
-        m.frontHair = hairPixels(front, out.frontMask, out.hair);
-        m.sideHair = hairPixels(side, out.sideMask, out.hair);
-    }
+    if (out.hair.style != HairStyle::None && m.frontHair.empty()) m.frontHair = hairPixels(front, out.frontMask, out.hair);
+    if (out.hair.style != HairStyle::None && m.sideHair.empty()) m.sideHair = hairPixels(side, out.sideMask, out.hair);
     out.texture = runStep(out, control, FitStep::Texture, names, [&] {
         return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture,
                                  *textureTables_, ColourMatchMasks{m.frontHair, m.sideHair});

@@ -3,6 +3,7 @@
 // folder is booth/session_folder.h's; the character is made from the outcome by reveal/character.
 #pragma once
 
+#include "fit/face/ear_locator.h"
 #include "fit/face/hair_analysis.h"
 #include "fit/face/landmarks68.h"
 #include "fit/face/profile.h"
@@ -57,6 +58,7 @@ struct FitOutcome {
     std::map<std::string, cv::Point2d> sideLandmarks;
     bool sideNoseImageRight = true;
     cv::Mat sideMask;
+    EarSpot sideEar;  // where the side photo shows the ear (fit/face/ear_locator.h)
     HairEstimate hair;  // the hair style, its colour, beard and moustache (fit/face/hair_analysis.h)
     // With a bob: how far over the brows the front photo shows the forehead, which the bob's fringe leaves clear
     // (fit/parts/hair_part.h foreheadShownMm); 0 otherwise.
@@ -150,6 +152,7 @@ private:
     std::unique_ptr<LandmarkDetector> detector_;
     std::shared_ptr<const TextureTables> textureTables_;  // shared with the pipelines forAnotherThread() made
     std::shared_ptr<FrontalFaceCheck> frontalCheck_;      // likewise (it is thread-safe)
+    std::shared_ptr<const EarTemplate> earTemplate_;      // likewise
     double modelLoadSeconds_ = 0.0;
 };
 

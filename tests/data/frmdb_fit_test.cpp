@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <cstdio>
 
@@ -76,6 +77,26 @@ double silhouetteAgreementAboveBrows(const FitOutcome& o, bool side, const fs::p
 
 }  // namespace
 
+// Where each side photo shows the ear (the auricle's box, photo pixels, read off the photos by eye), or that hair
+// hides it. Partly hidden: the locator may not find it, but what it finds must be the ear.
+struct EarInPhoto {
+    enum Shows { Clearly, Partly, Hidden } shows;
+    cv::Rect2d box;
+};
+const std::map<std::string, EarInPhoto>& earsInPhotos() {
+    static const std::map<std::string, EarInPhoto> ears{
+        {"001_Img_13.jpg", {EarInPhoto::Clearly, {545, 342, 67, 83}}}, {"001_Img_53.jpg", {EarInPhoto::Clearly, {335, 350, 65, 82}}},
+        {"002_Img_13.jpg", {EarInPhoto::Clearly, {515, 325, 95, 115}}}, {"002_Img_53.jpg", {EarInPhoto::Clearly, {325, 315, 95, 110}}},
+        {"003_Img_13.jpg", {EarInPhoto::Clearly, {540, 285, 70, 115}}}, {"003_Img_53.jpg", {EarInPhoto::Clearly, {275, 260, 75, 120}}},
+        {"004_Img_13.jpg", {EarInPhoto::Partly, {520, 345, 65, 85}}},   {"004_Img_53.jpg", {EarInPhoto::Clearly, {315, 315, 75, 95}}},
+        {"005_Img_13.jpg", {EarInPhoto::Clearly, {490, 230, 65, 110}}}, {"005_Img_53.jpg", {EarInPhoto::Clearly, {315, 230, 65, 105}}},
+        {"006_Img_13.jpg", {EarInPhoto::Clearly, {525, 340, 60, 100}}}, {"006_Img_53.jpg", {EarInPhoto::Clearly, {310, 330, 70, 95}}},
+        {"007_Img_13.jpg", {EarInPhoto::Hidden, {}}},                    {"007_Img_53.jpg", {EarInPhoto::Partly, {335, 290, 30, 80}}},
+        {"008_Img_13.jpg", {EarInPhoto::Clearly, {500, 320, 65, 95}}},  {"008_Img_53.jpg", {EarInPhoto::Clearly, {310, 300, 65, 75}}},
+    };
+    return ears;
+}
+
 class FrmdbFit : public ::testing::TestWithParam<std::tuple<int, const char*>> {};
 
 TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
@@ -107,6 +128,35 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
                 person, std::get<1>(GetParam()), outcome.fit.modifierRmsMm.first, outcome.fit.modifierRmsMm.second,
                 outcome.fit.foldsRemoved, std::sqrt(sum / static_cast<double>(std::max<std::size_t>(outcome.fit.residuals.size(), 1))));
     EXPECT_TRUE(folds.empty()) << folds.size() << " triangles turned over";
+    // The ear is found where the side photo shows it, and the fitted head's ears were moved there (the base head's
+    // ear sat where proportions put it: the side photo's ear was painted on the scalp behind and below it).
+    {
+        const EarInPhoto& ear = earsInPhotos().at(std::string(person) + "_" + std::get<1>(GetParam()));
+        const EarSpot& spot = outcome.sideEar;
+        std::printf("%s %s: ear %s at %.0f, %.0f (correlation %.2f); the head's ears moved %.1f mm forward, %.1f mm up "
+                    "(%.1f, %.1f wanted)\n",
+                    person, std::get<1>(GetParam()), spot.found ? "found" : "not found", spot.centre.x, spot.centre.y,
+                    spot.score, outcome.fit.earShiftMm.x, outcome.fit.earShiftMm.y, outcome.fit.earOffsetMm.x,
+                    outcome.fit.earOffsetMm.y);
+        if (ear.shows == EarInPhoto::Clearly) {
+            EXPECT_TRUE(spot.found) << "the ear the photo shows was not found";
+        }
+        if (ear.shows == EarInPhoto::Hidden) {
+            EXPECT_FALSE(spot.found) << "an ear was found under the hair";
+        }
+        if (spot.found) {
+            EXPECT_TRUE(ear.box.contains(spot.centre)) << "the ear found at " << spot.centre << " is not in " << ear.box;
+            EXPECT_TRUE(outcome.fit.earsPlaced);
+            // Moved by what was wanted, within the sliders' ranges (MakeHuman's ear translations: 10 mm back,
+            // 12.5 forward, 20 up or down at the base head's size).
+            for (int c = 0; c < 2; ++c) {
+                EXPECT_LE(std::abs(outcome.fit.earShiftMm[c]), std::abs(outcome.fit.earOffsetMm[c]) + 1e-9);
+                EXPECT_GE(outcome.fit.earShiftMm[c] * outcome.fit.earOffsetMm[c], 0.0);
+            }
+        } else {
+            EXPECT_FALSE(outcome.fit.earsPlaced);
+        }
+    }
     // The glb reads back with the same head (its first part: the fitted head without the eyeballs the eyes replace).
     const Mesh back = readGlbMesh(out / "avatar.glb");
     ASSERT_FALSE(outcome.parts.empty());

@@ -1,6 +1,8 @@
 // NTT fitting: scale the base head per axis, measure feature and contour points, warp by RBFs, merge the views.
 #include "fit/head/head_fit.h"
 
+#include "fit/head/ears.h"
+
 #include "common/error.h"
 #include "common/landmark_names.h"
 #include "fit/fit_error.h"
@@ -518,7 +520,24 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         mean /= static_cast<double>(std::max<std::size_t>(part.size(), 1));
         for (const auto v : part) fit.mesh.positions[v] = fit.scaledBase.positions[v] + mean;
     }
+    // --- The ears, last: moved to where the side photo shows the ear. After the warp, so that they move nothing else
+    // (the warp's targets, and so the face, are as they would be without them); before the folds are smoothed out.
+    if (options.placeEars && photos.sideEar && base.modifiers) {
+        const EarPlacement ears = placeEars(*base.modifiers, fit.mesh, fit.axisScale, fit.side.toHead(*photos.sideEar));
+        if (ears.placed) {
+            for (const auto& [v, d] : earDisplacements(*base.modifiers, ears, fit.axisScale)) {
+                fit.mesh.positions[v] += d;
+                fit.scaledBase.positions[v] += d;
+            }
+            for (std::size_t k = 0; k < ears.weights.size(); ++k)
+                if (ears.weights[k] > 0.0) fit.modifierWeights.emplace_back(base.modifiers->modifiers[k].name, ears.weights[k]);
+            fit.earShiftMm = ears.shiftMm;
+            fit.earOffsetMm = ears.offsetMm;
+            fit.earsPlaced = true;
+        }
+    }
     fit.foldsRemoved = unfold(fit.scaledBase, fit.mesh);
+
 
     for (const ViewTargets* view : {&frontT, &sideT})
         for (std::size_t k = 0; k < view->vertices.size(); ++k) {

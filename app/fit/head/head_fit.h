@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,8 @@ struct PhotoMeasurements {
     bool sideNoseImageRight = true;                   // false: the side photo is mirrored before use
     // Hair pixels of each photo as taken (CV_8U, 255 on hair; empty: not known), for hairOutlineSlackMm.
     cv::Mat frontHair, sideHair;
+    // The middle of the ear in the side photo as taken (fit/face/ear_locator.h), when it was found.
+    std::optional<cv::Point2d> sideEar;
 };
 
 struct HeadFitOptions {
@@ -64,6 +67,11 @@ struct HeadFitOptions {
     // the skull stays where the modifiers put it under a separate hair part. 0: every crossing counts (the hair
     // analysis sets it when the hair is big).
     double hairOutlineSlackMm = 0.0;
+    // With a modifier basis and the side photo's ear found: the fitted head's ears are moved last (MakeHuman's ear
+    // translations, both ears alike) so that the ear's middle lies where the side photo shows it, within the
+    // sliders' ranges. The base head's ear sits where proportions put it, and the side photo's ear was painted on
+    // the scalp or the neck beside it.
+    bool placeEars = true;
 };
 
 HeadFitOptions defaultHeadFitOptions();
@@ -106,6 +114,10 @@ struct HeadFit {
     std::vector<std::pair<std::string, double>> modifierWeights;
     std::pair<double, double> modifierRmsMm{0.0, 0.0};
     std::size_t foldsRemoved = 0;  // triangles the warp had turned over, before they were smoothed out
+    // How far the ears were moved to the side photo's ear (millimetres, forward and up; 0 when they were not), and
+    // how far that ear lay from the shaped head's before (the same, unclamped).
+    glm::dvec2 earShiftMm{0.0}, earOffsetMm{0.0};
+    bool earsPlaced = false;
 };
 
 // Throws BoothError(Mismatch) when the photos disagree (scale ratio, shared heights), NoFace when a needed

@@ -1,0 +1,151 @@
+#include "fit/face/ear_locator.h"
+
+#include "fit/face/profile.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+namespace avatarbooth {
+
+namespace {
+
+// The photo round the head's side, facing image-right (mirrored when the face points left).
+struct SideCrop {
+    cv::Mat bgr, mask, hair;  // hair: CV_8U, 255 on hair (all 0 when none is known)
+    cv::Point origin;         // the crop's top-left corner in the facing-right photo
+    cv::Point2d tip;          // facing-right photo pixels
+    double V = 0.0;           // the nose tip's height under the top of the head (pixels)
+};
+
+// The edges' directions, angle doubled (an edge and its reverse alike): two channels, m cos 2a and m sin 2a, with m
+// the edge's strength saturating at `knee` (so that hair's many strong edges do not outweigh the ear's).
+std::pair<cv::Mat, cv::Mat> edgeDirections(const cv::Mat& grey, double knee) {
+    cv::Mat gx, gy;
+    cv::Sobel(grey, gx, CV_32F, 1, 0);
+    cv::Sobel(grey, gy, CV_32F, 0, 1);
+    cv::Mat c(grey.size(), CV_32F), s(grey.size(), CV_32F);
+    for (int y = 0; y < grey.rows; ++y)
+        for (int x = 0; x < grey.cols; ++x) {
+            const double u = gx.at<float>(y, x), v = gy.at<float>(y, x), m2 = u * u + v * v;
+            const double m = std::sqrt(m2), w = m2 > 0.0 ? (m / (m + knee)) / m2 : 0.0;
+            c.at<float>(y, x) = static_cast<float>((u * u - v * v) * w);
+            s.at<float>(y, x) = static_cast<float>(2.0 * u * v * w);
+        }
+    return {c, s};
+}
+
+// The template's reading: how well the photo's edges run along the template's (the helix's rim, the antihelix, the
+// concha's edge), at each of the sizes: the mean over the template's edges of cos 2(angle difference), weighted by
+// both strengths; random edges (hair, stubble) average out. Windows mostly on hair or off the person do not count.
+// Facing-right pixels of the ear's middle and the best score, or nothing.
+std::optional<std::pair<cv::Point2d, double>> templatePeak(const SideCrop& c, const EarTemplate& ear,
+                                                           const cv::Point2d& expected, const EarLocatorOptions& o,
+                                                           double* scaleOut) {
+    const double pxPerMm = c.V / ear.noseTipToTop;
+    cv::Mat grey;
+    cv::cvtColor(c.bgr, grey, cv::COLOR_BGR2GRAY);
+    grey.convertTo(grey, CV_32F, 1.0 / 255.0);
+    const double blur = std::max(0.5, 0.6 * pxPerMm);
+    cv::GaussianBlur(grey, grey, {0, 0}, blur);
+    const auto [pc, ps] = edgeDirections(grey, 0.05);
+    double best = -2.0;
+    cv::Point2d at;
+    for (const double s : o.scales) {
+        const double f = ear.mmPerPixel * pxPerMm * s;
+        cv::Mat templ, tmask;
+        cv::resize(ear.shade, templ, {}, f, f, cv::INTER_AREA);
+        cv::resize(ear.mask, tmask, templ.size(), 0, 0, cv::INTER_NEAREST);
+        if (templ.cols >= grey.cols || templ.rows >= grey.rows || templ.cols < 6 || templ.rows < 6) continue;
+        cv::GaussianBlur(templ, templ, {0, 0}, blur);
+        const int g = std::max(1, cvRound(2.0 * pxPerMm));
+        cv::dilate(tmask, tmask, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * g + 1, 2 * g + 1}));
+        auto [tc, ts] = edgeDirections(templ, 0.05);
+        tc.setTo(0.0f, tmask == 0);
+        ts.setTo(0.0f, tmask == 0);
+        double weight = 0.0;
+        for (int y = 0; y < tc.rows; ++y)
+            for (int x = 0; x < tc.cols; ++x) weight += std::hypot(tc.at<float>(y, x), ts.at<float>(y, x));
+        if (weight <= 0.0) continue;
+        cv::Mat sc, ss;
+        cv::matchTemplate(pc, tc, sc, cv::TM_CCORR);
+        cv::matchTemplate(ps, ts, ss, cv::TM_CCORR);
+        const cv::Mat score = (sc + ss) / weight;
+        // The best places within the search first; the first whose window is not mostly hair and lies on the person.
+        std::vector<std::pair<float, cv::Point>> places;
+        for (int y = 0; y < score.rows; ++y)
+            for (int x = 0; x < score.cols; ++x) {
+                const cv::Point2d centre(c.origin.x + x + ear.centre.x * f, c.origin.y + y + ear.centre.y * f);
+                const float v = score.at<float>(y, x);
+                if (v > best && std::isfinite(v) && std::abs(centre.x - expected.x) <= o.searchAlong * c.V &&
+                    std::abs(centre.y - expected.y) <= o.searchUpDown * c.V)
+                    places.emplace_back(v, cv::Point(x, y));
+            }
+        std::sort(places.begin(), places.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+        std::vector<cv::Point> window;
+        cv::findNonZero(tmask, window);
+        for (const auto& [v, p] : places) {
+            int onHair = 0, onPerson = 0;
+            for (const cv::Point& q : window) {
+                onHair += c.hair.at<unsigned char>(p + q) != 0;
+                onPerson += c.mask.at<unsigned char>(p + q) != 0;
+            }
+            if (2 * onHair > static_cast<int>(window.size()) || onPerson < 0.95 * static_cast<double>(window.size())) continue;
+            best = v;
+            at = {c.origin.x + p.x + ear.centre.x * f, c.origin.y + p.y + ear.centre.y * f};
+            *scaleOut = s;
+            break;
+        }
+    }
+    if (best < -1.0) return std::nullopt;
+    return std::make_pair(at, best);
+}
+
+}  // namespace
+
+EarSpot locateEar(const cv::Mat& bgrIn, const cv::Mat& maskIn, const cv::Mat& hairIn,
+                  const std::vector<ProfilePoint>& landmarks, bool noseImageRight, const EarTemplate& ear,
+                  const EarLocatorOptions& o) {
+    EarSpot spot;
+    if (bgrIn.empty() || maskIn.size() != bgrIn.size() || ear.empty()) return spot;
+    const int W = bgrIn.cols;
+    const auto canon = [&](const char* name) {
+        cv::Point2d p = profilePoint(landmarks, name);
+        if (!noseImageRight) p.x = W - 1 - p.x;
+        return p;
+    };
+    SideCrop c;
+    c.tip = canon("nose_tip");
+    c.V = c.tip.y - canon("top_of_head").y;
+    if (c.V < 20.0) return spot;
+    const double V = c.V, pxPerMm = V / ear.noseTipToTop;
+    const cv::Point2d expected(c.tip.x - ear.behindNoseTip * V, c.tip.y - ear.aboveNoseTip * V);
+    const double biggest = o.scales.empty() ? 1.0 : *std::max_element(o.scales.begin(), o.scales.end());
+    const double tw = ear.shade.cols * ear.mmPerPixel * pxPerMm * biggest, th = ear.shade.rows * ear.mmPerPixel * pxPerMm * biggest;
+    // Both readings' areas: the template's search and the cheek up to the nose tip.
+    const cv::Rect wanted(cvRound(expected.x - o.searchAlong * V - tw), cvRound(expected.y - o.searchUpDown * V - th),
+                          cvRound(2 * o.searchAlong * V + 2 * tw), cvRound(2 * o.searchUpDown * V + 2 * th));
+    const cv::Rect taken = noseImageRight ? wanted : cv::Rect(W - wanted.x - wanted.width, wanted.y, wanted.width, wanted.height);
+    const cv::Rect inPhoto = taken & cv::Rect(0, 0, W, bgrIn.rows);
+    if (inPhoto.width < 8 || inPhoto.height < 8) return spot;
+    c.bgr = bgrIn(inPhoto).clone();
+    c.mask = maskIn(inPhoto).clone();
+    c.hair = hairIn.size() == bgrIn.size() ? hairIn(inPhoto).clone() : cv::Mat(c.mask.size(), CV_8U, cv::Scalar(0));
+    if (!noseImageRight)
+        for (cv::Mat* m : {&c.bgr, &c.mask, &c.hair}) cv::flip(*m, *m, 1);
+    c.origin = {noseImageRight ? inPhoto.x : W - inPhoto.x - inPhoto.width, inPhoto.y};
+
+    double scale = 0.0;
+    const auto edges = templatePeak(c, ear, expected, o, &scale);
+    if (!edges) return spot;
+    spot.centre = edges->first;
+    if (!noseImageRight) spot.centre.x = W - 1 - spot.centre.x;
+    spot.score = edges->second;
+    spot.scale = scale;
+    spot.found = spot.score >= o.minScore;
+    return spot;
+}
+
+}  // namespace avatarbooth
