@@ -37,7 +37,7 @@ std::pair<cv::Mat, cv::Mat> edgeDirections(const cv::Mat& grey, double knee) {
     return {c, s};
 }
 
-// The template's reading: how well the photo's edges run along the template's (the helix's rim, the antihelix, the
+// How well the photo's edges run along the template's (the helix's rim, the antihelix, the
 // concha's edge), at each of the sizes: the mean over the template's edges of cos 2(angle difference), weighted by
 // both strengths; random edges (hair, stubble) average out. Windows mostly on hair or off the person do not count.
 // Facing-right pixels of the ear's middle and the best score, or nothing.
@@ -124,7 +124,7 @@ EarSpot locateEar(const cv::Mat& bgrIn, const cv::Mat& maskIn, const cv::Mat& ha
     const cv::Point2d expected(c.tip.x - ear.behindNoseTip * V, c.tip.y - ear.aboveNoseTip * V);
     const double biggest = o.scales.empty() ? 1.0 : *std::max_element(o.scales.begin(), o.scales.end());
     const double tw = ear.shade.cols * ear.mmPerPixel * pxPerMm * biggest, th = ear.shade.rows * ear.mmPerPixel * pxPerMm * biggest;
-    // Both readings' areas: the template's search and the cheek up to the nose tip.
+    // The search, with the largest template's size round it.
     const cv::Rect wanted(cvRound(expected.x - o.searchAlong * V - tw), cvRound(expected.y - o.searchUpDown * V - th),
                           cvRound(2 * o.searchAlong * V + 2 * tw), cvRound(2 * o.searchUpDown * V + 2 * th));
     const cv::Rect taken = noseImageRight ? wanted : cv::Rect(W - wanted.x - wanted.width, wanted.y, wanted.width, wanted.height);

@@ -7,6 +7,7 @@
 #include "fit/head/mesh.h"
 
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -45,8 +46,7 @@ EarPlacement placeEars(const ModifierBasis& basis, const Mesh& head, const glm::
 // temple along up to 70 mm ahead of the ear hole (a third of the ear's move on the face's side).
 std::vector<std::pair<std::uint32_t, glm::dvec3>> earDisplacements(const ModifierBasis& basis, const EarPlacement& placement,
                                                                    const glm::dvec3& axisScale);
-// Measured (README, "ears"): with MakeHuman's falloff the Lee Perry-Smith scan's face-region RMS went 1.65 -> 1.69
-// mm from its left profile; fading out at 0.35 1.66, at 0.5 1.66 with a crease left in front of the ear's lobe.
+// Where the move has faded out (the trials that chose it: README, "ears").
 inline constexpr double kEarMoveFadesTo = 0.35;
 
 }  // namespace avatarbooth
