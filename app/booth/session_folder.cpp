@@ -68,7 +68,8 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
     report["side_ear"] = {{"found", o.sideEar.found}, {"centre_px", {o.sideEar.centre.x, o.sideEar.centre.y}},
                           {"score", o.sideEar.score}, {"scale", o.sideEar.scale},
                           {"placed", o.fit.earsPlaced}, {"offset_mm", {o.fit.earOffsetMm.x, o.fit.earOffsetMm.y}},
-                          {"shift_mm", {o.fit.earShiftMm.x, o.fit.earShiftMm.y}}};
+                          {"shift_mm", {o.fit.earShiftMm.x, o.fit.earShiftMm.y}},
+                          {"left_to_texture_mm", {o.fit.earLeftMm.x, o.fit.earLeftMm.y}}};
     nlohmann::json stages = nlohmann::json::array();
     double total = 0.0;
     for (const auto& [name, seconds] : o.stageSeconds) {

@@ -134,10 +134,10 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
         const EarInPhoto& ear = earsInPhotos().at(std::string(person) + "_" + std::get<1>(GetParam()));
         const EarSpot& spot = outcome.sideEar;
         std::printf("%s %s: ear %s at %.0f, %.0f (correlation %.2f); the head's ears moved %.1f mm forward, %.1f mm up "
-                    "(%.1f, %.1f wanted)\n",
+                    "(%.1f, %.1f wanted; %.1f, %.1f left to the texture)\n",
                     person, std::get<1>(GetParam()), spot.found ? "found" : "not found", spot.centre.x, spot.centre.y,
                     spot.score, outcome.fit.earShiftMm.x, outcome.fit.earShiftMm.y, outcome.fit.earOffsetMm.x,
-                    outcome.fit.earOffsetMm.y);
+                    outcome.fit.earOffsetMm.y, outcome.fit.earLeftMm.x, outcome.fit.earLeftMm.y);
         if (ear.shows == EarInPhoto::Clearly) {
             EXPECT_TRUE(spot.found) << "the ear the photo shows was not found";
         }

@@ -369,6 +369,45 @@ TEST(PhotoTexture, FrontPhotoIsPreferredRoundFrontFeatures) {
     EXPECT_LT(preferredError, 6.0);
 }
 
+// The side photo's ear lies 25 mm behind where the ears' sliders could take the head's (HeadFit::earLeftMm): round
+// the head's ear the side photo is read shifted by that, so that the photo's ear (a red disc) lands on the head's ear
+// (the side-facing square's middle) and not beside it; far from the ear the photo is read where it lies (a blue disc).
+TEST(PhotoTexture, SidePhotosEarLandsOnTheHeadsEar) {
+    Mesh mesh;
+    constexpr double half = 100.0;
+    addSquare(mesh, {-60, 0, 0}, {0, 0, 1}, {0, 1, 0}, half, {0.0, 0.0, 1.0, 1.0}, {-1, 0, 0});
+    HeadFit fit = photoFrames();
+    fit.side.mmPerPixel = 0.6;  // the square's 200 mm in the photo's 400 pixels
+    const cv::Mat front(400, 400, CV_8UC3, cv::Scalar(kGreen));
+    const cv::Mat side = paintPhoto(fit, true, [](glm::dvec2 p) {
+        if (glm::distance(p, glm::dvec2(-25.0, 0.0)) < 10.0) return kRed;
+        if (glm::distance(p, glm::dvec2(90.0, 80.0)) < 8.0) return kBlue;
+        return kGreen;
+    });
+    const cv::Mat all(400, 400, CV_8U, cv::Scalar(255));
+    PhotoTextureOptions o;
+    o.size = 256;
+    // The texel of the square's point (z, y), and its colour.
+    const auto at = [&](const PhotoTexture& t, double z, double y) {
+        const int u = static_cast<int>((z / half + 1.0) / 2.0 * o.size), v = static_cast<int>((1.0 - (y / half + 1.0) / 2.0) * o.size);
+        return cv::Vec3i(t.texture.at<cv::Vec3b>(v, u));
+    };
+    const auto near = [](cv::Vec3i a, cv::Vec3b b) { return cv::norm(a - cv::Vec3i(b)) < 40.0; };
+
+    const PhotoTexture unplaced = textureFromPhotos(mesh, fit, front, all, side, all, o);
+    EXPECT_TRUE(near(at(unplaced, -25.0, 0.0), kRed)) << "without a placement the photo is read where it lies";
+    EXPECT_TRUE(near(at(unplaced, 0.0, 0.0), kGreen));
+
+    fit.earsPlaced = true;
+    fit.earMiddleMm = {-60.0, 0.0, 0.0};
+    fit.earLeftMm = {-25.0, 0.0};
+    const PhotoTexture placed = textureFromPhotos(mesh, fit, front, all, side, all, o);
+    EXPECT_TRUE(near(at(placed, 0.0, 0.0), kRed)) << "the photo's ear on the head's ear";
+    EXPECT_TRUE(near(at(placed, 0.0, 6.0), kRed));
+    EXPECT_TRUE(near(at(placed, -25.0, 0.0), kGreen)) << "no second ear beside it";
+    EXPECT_TRUE(near(at(placed, 90.0, 80.0), kBlue)) << "far from the ear the photo is read where it lies";
+}
+
 // No photo sees the back of the sphere: it is filled from the colours around it, not left black.
 TEST(PhotoTexture, UnseenTexelsAreFilledWithSurroundingColours) {
     const Mesh sphere = uvSphere(kRadius);

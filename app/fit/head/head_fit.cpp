@@ -537,6 +537,11 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         }
     }
     fit.foldsRemoved = unfold(fit.scaledBase, fit.mesh);
+    if (fit.earsPlaced) {
+        const std::vector<std::uint32_t> ear = rigidlyMovedVertices(*base.modifiers, "ears/r-ear-trans-depth-backward");
+        for (const auto v : ear) fit.earMiddleMm += fit.mesh.positions[v] / static_cast<double>(ear.size());
+        fit.earLeftMm = fit.side.toHead(*photos.sideEar) - glm::dvec2(fit.earMiddleMm.z, fit.earMiddleMm.y);
+    }
 
 
     for (const ViewTargets* view : {&frontT, &sideT})

@@ -118,6 +118,11 @@ struct HeadFit {
     // how far that ear lay from the shaped head's before (the same, unclamped).
     glm::dvec2 earShiftMm{0.0}, earOffsetMm{0.0};
     bool earsPlaced = false;
+    // When they were placed: the right ear's middle on the fitted head (its vertices' mean), and what the sliders'
+    // ranges left between it and the side photo's ear (side view: forward, up), which the texture takes up
+    // (PhotoTextureOptions::earReachMm).
+    glm::dvec3 earMiddleMm{0.0};
+    glm::dvec2 earLeftMm{0.0};
 };
 
 // Throws BoothError(Mismatch) when the photos disagree (scale ratio, shared heights), NoFace when a needed

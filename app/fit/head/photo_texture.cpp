@@ -346,13 +346,23 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     };
     const std::vector<glm::dvec3> normals = fitted.vertexNormals();
     const std::vector<glm::dvec3> smooth = smoothedNormals(fitted, normals, kDecisionRings);
+    // The side photo's reading shifted round the ears by what the ears' placement left (both ears: the photo stands in
+    // for the far side too).
+    const double earFade = std::max(options.earFadeMm, 2.0 * glm::length(fit.earLeftMm));
+    const auto earShift = [&](const glm::dvec3& p) {
+        if (!fit.earsPlaced) return glm::dvec2(0.0);
+        const glm::dvec3& m = fit.earMiddleMm;
+        const glm::dvec3 ear = (p.x < 0.0) == (m.x < 0.0) ? m : glm::dvec3(-m.x, m.y, m.z);
+        const double t = std::clamp((glm::distance(p, ear) - options.earReachMm) / earFade, 0.0, 1.0);
+        return (1.0 - t * t * (3.0 - 2.0 * t)) * fit.earLeftMm;
+    };
     std::vector<VertexViews> views(fitted.positions.size());
     std::array<std::vector<ViewVertex>, 3> depthVertices;  // front, from -x, from +x
     for (auto& d : depthVertices) d.resize(fitted.positions.size());
     for (std::size_t i = 0; i < fitted.positions.size(); ++i) {
         const glm::dvec3& p = fitted.positions[i];
         const cv::Point2d f = fit.front.toPixel({p.x, p.y});
-        const cv::Point2d s = fit.side.toPixel({p.z, p.y});
+        const cv::Point2d s = fit.side.toPixel(glm::dvec2(p.z, p.y) + earShift(p));
         const glm::dvec3& n = normals[i];
         const glm::dvec3& m = smooth[i];
         VertexViews& v = views[i];

@@ -38,6 +38,12 @@ struct PhotoTextureOptions {
     int blendBands = 5;
     // Depth tolerance of the visibility test in millimetres, on top of what the pixel size and slope allow.
     double depthToleranceMm = 2.0;
+    // Where the side photo's ear lies further off than the ears' sliders could move the head's (HeadFit::earLeftMm),
+    // the side photo is read shifted by what is left round the ears, so that its ear lands on the head's instead of
+    // beside it on the scalp or the neck: in full within earReachMm of the ear's middle (the ear itself), fading out
+    // smoothly over earFadeMm, or over twice the shift if that is more (so that the shifted reading cannot fold).
+    double earReachMm = 30.0;
+    double earFadeMm = 40.0;
 };
 
 struct PhotoTexture {
