@@ -228,7 +228,6 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         for (const auto& [name, v] : *features) out.featurePoints.emplace_back(name, out.fit.mesh.positions[v]);
     // The photos' hair, for the texture's exposure match (skin against skin) and the short hair's trim.
     if (out.hair.style != HairStyle::None && m.frontHair.empty()) m.frontHair = hairPixels(front, out.frontMask, out.hair);
-    if (out.hair.style != HairStyle::None && m.sideHair.empty()) m.sideHair = hairPixels(side, out.sideMask, out.hair);
     out.texture = runStep(out, control, FitStep::Texture, names, [&] {
         return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture,
                                  *textureTables_, ColourMatchMasks{m.frontHair, m.sideHair});

@@ -104,16 +104,17 @@ EarTemplate makeEarTemplate(const BaseHead& base) {
     if (!base.modifiers || !base.sideFeatures.count("nose_tip") || !base.sideFeatures.count("top_of_head")) return {};
     const glm::dvec3 tip = base.mesh.positions[base.sideFeatures.at("nose_tip")];
     const double V = base.mesh.positions[base.sideFeatures.at("top_of_head")].y - tip.y;
-    return makeEarTemplate(base.mesh, rigidlyMovedVertices(*base.modifiers, "ears/r-ear-trans-depth-backward"), V, tip);
+    return makeEarTemplate(base.mesh, rigidlyMovedVertices(*base.modifiers, kRightEarTranslation), V, tip);
 }
 
 EarPlacement placeEars(const ModifierBasis& basis, const Mesh& head, const glm::dvec3& axisScale,
                        const glm::dvec2& photoEar) {
     EarPlacement out;
-    const std::vector<std::uint32_t> ear = rigidlyMovedVertices(basis, "ears/r-ear-trans-depth-backward");
-    if (ear.empty()) return out;
+    out.earVertices = rigidlyMovedVertices(basis, kRightEarTranslation);
+    if (out.earVertices.empty()) return out;
     glm::dvec2 middle(0.0);
-    for (const auto v : ear) middle += glm::dvec2(head.positions[v].z, head.positions[v].y) / static_cast<double>(ear.size());
+    for (const auto v : out.earVertices)
+        middle += glm::dvec2(head.positions[v].z, head.positions[v].y) / static_cast<double>(out.earVertices.size());
     out.offsetMm = photoEar - middle;
     out.weights.assign(basis.modifiers.size(), 0.0);
     // One axis: the modifier each way and how far it moves the ear at weight 1 (scaled as the head is).

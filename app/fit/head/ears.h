@@ -21,8 +21,10 @@ EarTemplate makeEarTemplate(const Mesh& head, const std::vector<std::uint32_t>& 
                             const glm::dvec3& noseTip, double mmPerPixel = 0.5);
 
 // The vertices a modifier moves rigidly (by over 0.99 of its longest offset): the ear itself for MakeHuman's ear translations
-// ("ears/r-ear-trans-depth-backward": the right ear). Empty when the basis has no such modifier.
+// (kRightEarTranslation: the right ear). Empty when the basis has no such modifier.
 std::vector<std::uint32_t> rigidlyMovedVertices(const ModifierBasis& basis, const std::string& modifier);
+// The right ear's translation, whose rigidly moved vertices are the ear the template shows and the placement moves.
+inline constexpr const char* kRightEarTranslation = "ears/r-ear-trans-depth-backward";
 
 // The template of the base head's right ear (empty without a modifier basis, which says where the ear is).
 EarTemplate makeEarTemplate(const BaseHead& base);
@@ -36,6 +38,7 @@ struct EarPlacement {
     std::vector<double> weights;    // to add to the modifier weights (basis order)
     glm::dvec2 offsetMm{0.0};       // photoEar less the head's ear middle (forward, up)
     glm::dvec2 shiftMm{0.0};        // what the weights move the ears by (the offset within the ranges)
+    std::vector<std::uint32_t> earVertices;  // the right ear's (rigidlyMovedVertices of kRightEarTranslation)
 };
 EarPlacement placeEars(const ModifierBasis& basis, const Mesh& head, const glm::dvec3& axisScale,
                        const glm::dvec2& photoEar);

@@ -522,8 +522,9 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
     }
     // --- The ears, last: moved to where the side photo shows the ear. After the warp, so that they move nothing else
     // (the warp's targets, and so the face, are as they would be without them); before the folds are smoothed out.
+    EarPlacement ears;
     if (options.placeEars && photos.sideEar && base.modifiers) {
-        const EarPlacement ears = placeEars(*base.modifiers, fit.mesh, fit.axisScale, fit.side.toHead(*photos.sideEar));
+        ears = placeEars(*base.modifiers, fit.mesh, fit.axisScale, fit.side.toHead(*photos.sideEar));
         if (ears.placed) {
             for (const auto& [v, d] : earDisplacements(*base.modifiers, ears, fit.axisScale)) {
                 fit.mesh.positions[v] += d;
@@ -537,9 +538,8 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         }
     }
     fit.foldsRemoved = unfold(fit.scaledBase, fit.mesh);
-    if (fit.earsPlaced) {
-        const std::vector<std::uint32_t> ear = rigidlyMovedVertices(*base.modifiers, "ears/r-ear-trans-depth-backward");
-        for (const auto v : ear) fit.earMiddleMm += fit.mesh.positions[v] / static_cast<double>(ear.size());
+    if (fit.earsPlaced) {  // where the ear ended up (the fold repair may have moved it a little)
+        for (const auto v : ears.earVertices) fit.earMiddleMm += fit.mesh.positions[v] / static_cast<double>(ears.earVertices.size());
         fit.earLeftMm = fit.side.toHead(*photos.sideEar) - glm::dvec2(fit.earMiddleMm.z, fit.earMiddleMm.y);
     }
 
