@@ -70,6 +70,9 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
                           {"placed", o.fit.earsPlaced}, {"offset_mm", {o.fit.earOffsetMm.x, o.fit.earOffsetMm.y}},
                           {"shift_mm", {o.fit.earShiftMm.x, o.fit.earShiftMm.y}},
                           {"left_to_texture_mm", {o.fit.earLeftMm.x, o.fit.earLeftMm.y}}};
+    report["side_eye"] = {{"found", o.sideEye.found}, {"centre_px", {o.sideEye.centre.x, o.sideEye.centre.y}},
+                          {"contrast", o.sideEye.contrast},
+                          {"left_to_texture_mm", {o.fit.eyeLeftMm.x, o.fit.eyeLeftMm.y}}};
     nlohmann::json stages = nlohmann::json::array();
     double total = 0.0;
     for (const auto& [name, seconds] : o.stageSeconds) {

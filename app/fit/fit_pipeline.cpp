@@ -220,6 +220,8 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
             if (m.sideHair.empty() && out.hair.style != HairStyle::None) m.sideHair = hairPixels(side, out.sideMask, out.hair);
             out.sideEar = locateEar(side, out.sideMask, m.sideHair, profile, out.sideNoseImageRight, *earTemplate_);
             if (out.sideEar.found) m.sideEar = out.sideEar.centre;
+            out.sideEye = locateSideEye(side, out.sideMask, m.sideHair, profile, out.sideNoseImageRight);
+            if (out.sideEye.found) m.sideEye = out.sideEye.centre;
         }
         return fitHead(base_, m, head);
     });

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "fit/face/ear_locator.h"
+#include "fit/face/side_eye.h"
 #include "fit/face/hair_analysis.h"
 #include "fit/face/landmarks68.h"
 #include "fit/face/profile.h"
@@ -59,6 +60,7 @@ struct FitOutcome {
     bool sideNoseImageRight = true;
     cv::Mat sideMask;
     EarSpot sideEar;  // where the side photo shows the ear (fit/face/ear_locator.h)
+    SideEyeSpot sideEye;  // where the side photo shows the near eye (fit/face/side_eye.h)
     HairEstimate hair;  // the hair style, its colour, beard and moustache (fit/face/hair_analysis.h)
     // With a bob: how far over the brows the front photo shows the forehead, which the bob's fringe leaves clear
     // (fit/parts/hair_part.h foreheadShownMm); 0 otherwise.

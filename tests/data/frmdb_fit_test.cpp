@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <cmath>
 #include <cstdio>
 
@@ -97,6 +98,22 @@ const std::map<std::string, EarInPhoto>& earsInPhotos() {
     return ears;
 }
 
+// Where each side photo shows the near eye (the middle of its lashes, iris and lids, photo pixels, read off the
+// photos by eye), or none where hair hides it (007's left profile).
+const std::map<std::string, std::optional<cv::Point2d>>& eyesInPhotos() {
+    static const std::map<std::string, std::optional<cv::Point2d>> eyes{
+        {"001_Img_13.jpg", cv::Point2d(435, 325)}, {"001_Img_53.jpg", cv::Point2d(490, 307)},
+        {"002_Img_13.jpg", cv::Point2d(410, 296)}, {"002_Img_53.jpg", cv::Point2d(515, 290)},
+        {"003_Img_13.jpg", cv::Point2d(423, 287)}, {"003_Img_53.jpg", cv::Point2d(474, 277)},
+        {"004_Img_13.jpg", cv::Point2d(427, 309)}, {"004_Img_53.jpg", cv::Point2d(487, 315)},
+        {"005_Img_13.jpg", cv::Point2d(412, 238)}, {"005_Img_53.jpg", cv::Point2d(484, 233)},
+        {"006_Img_13.jpg", cv::Point2d(432, 325)}, {"006_Img_53.jpg", cv::Point2d(472, 314)},
+        {"007_Img_13.jpg", std::nullopt},          {"007_Img_53.jpg", cv::Point2d(492, 275)},
+        {"008_Img_13.jpg", cv::Point2d(410, 312)}, {"008_Img_53.jpg", cv::Point2d(495, 316)},
+    };
+    return eyes;
+}
+
 class FrmdbFit : public ::testing::TestWithParam<std::tuple<int, const char*>> {};
 
 TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
@@ -155,6 +172,27 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
             }
         } else {
             EXPECT_FALSE(outcome.fit.earsPlaced);
+        }
+    }
+    // The near eye is found where the side photo shows it (within 20 px, 13 mm, along and 16 px up or down: the
+    // darkest spot, the lashes and the iris, lies off the eye's middle by up to 14 px), and the texture reads the
+    // side photo shifted by its offset from the head's eye (measured: 002-007's right profiles, Img_53, 10-23 mm
+    // further back than the head's, turned short of a profile; the left ones, and 001's and 008's right, within 4 mm,
+    // but 001's left 12).
+    {
+        const std::optional<cv::Point2d>& eye = eyesInPhotos().at(std::string(person) + "_" + std::get<1>(GetParam()));
+        const SideEyeSpot& spot = outcome.sideEye;
+        std::printf("%s %s: eye %s at %.0f, %.0f (contrast %.0f); %.1f mm forward, %.1f mm up of the head's\n", person,
+                    std::get<1>(GetParam()), spot.found ? "found" : "not found", spot.centre.x, spot.centre.y,
+                    spot.contrast, outcome.fit.eyeLeftMm.x, outcome.fit.eyeLeftMm.y);
+        if (eye) {
+            EXPECT_TRUE(spot.found) << "the eye the photo shows was not found";
+            EXPECT_LE(std::abs(spot.centre.x - eye->x), 20.0) << spot.centre << " against " << *eye;
+            EXPECT_LE(std::abs(spot.centre.y - eye->y), 16.0) << spot.centre << " against " << *eye;
+            EXPECT_TRUE(outcome.fit.sideEyeFound);
+        } else {
+            EXPECT_FALSE(spot.found) << "an eye was found under the hair at " << spot.centre;
+            EXPECT_FALSE(outcome.fit.sideEyeFound);
         }
     }
     // The glb reads back with the same head (its first part: the fitted head without the eyeballs the eyes replace).

@@ -109,6 +109,10 @@ TEST(TurnedProfiles, FitFrom70To110AndSayWhichWayToTurnBeyond) {
                                   a.turn.ear.fold, a.turn.pastProfile ? " past" : "");
             } catch (const BoothError&) {
             }
+            if (o)  // the side photo's eye against the head's: how far the texture reads the side photo shifted
+                std::printf("     side photo's eye %s (contrast %.0f): %.1f mm forward, %.1f mm up of the head's\n",
+                            o->fit.sideEyeFound ? "used" : o->sideEye.found ? "off the eye's height" : "not found",
+                            o->sideEye.contrast, o->fit.eyeLeftMm.x, o->fit.eyeLeftMm.y);
             std::printf("%4u %4d %5s  %-8s %7.2f  %s | %s\n", seed, yaw, options.sideNoseImageRight ? "right" : "left",
                         toString(hint), r, cues.c_str(), o ? "fitted" : failure.c_str());
             if (!out.empty()) {

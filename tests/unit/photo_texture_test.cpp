@@ -319,16 +319,16 @@ TEST(PhotoTexture, SidePhotosExposureIsMatchedOnSkinNotOnHair) {
     EXPECT_LT(s.acrossSeam, 2.0 * s.withinFront + 1.0);
 }
 
-// The side photo shows a dark mark where the surface turns 70 degrees from the front (as a brow's tail lands on the
+// The side photo shows a dark mark where the surface turns 55 degrees from the front (as a brow's tail lands on the
 // temple when the fitted depth there is a few millimetres off); the front photo shows the sphere's own colour. By
-// default the side photo takes that surface (beyond about 63 degrees). With a front feature vertex beside it, the
-// front photo is preferred there (up to about 81 degrees) and the mark is gone.
+// default the side photo takes that surface (beyond about 51 degrees). With a front feature vertex beside it, the
+// front photo is preferred there (up to about 63 degrees) and the mark is gone.
 TEST(PhotoTexture, FrontPhotoIsPreferredRoundFrontFeatures) {
     const Mesh sphere = uvSphere(kRadius);
     const HeadFit fit = photoFrames();
     cv::Mat frontMask, sideMask;
     const auto same = [](const glm::dvec3&) { return 1.0; };
-    const double yaw = 70.0 * kPi / 180.0;
+    const double yaw = 55.0 * kPi / 180.0;
     const glm::dvec3 spot(-kRadius * std::sin(yaw), 0.0, kRadius * std::cos(yaw));
     const auto marked = [&](const glm::dvec3& p) { return glm::distance(p, spot) < 8.0 ? 0.15 : 1.0; };
     const cv::Mat front = spherePhoto(fit, false, frontMask, same), side = spherePhoto(fit, true, sideMask, marked);
@@ -361,7 +361,7 @@ TEST(PhotoTexture, FrontPhotoIsPreferredRoundFrontFeatures) {
     };
     int plainFront = 0, preferredFront = 0;
     const double plainError = errorAtSpot(plain, plainFront), preferredError = errorAtSpot(preferred, preferredFront);
-    std::printf("at 70 degrees: %d %% from the front photo, error %.1f; with a front feature beside it %d %%, error %.1f\n",
+    std::printf("at 55 degrees: %d %% from the front photo, error %.1f; with a front feature beside it %d %%, error %.1f\n",
                 plainFront, plainError, preferredFront, preferredError);
     EXPECT_EQ(plainFront, 0);
     EXPECT_GT(plainError, 40.0) << "the side photo's mark should show without the preference";
@@ -406,6 +406,45 @@ TEST(PhotoTexture, SidePhotosEarLandsOnTheHeadsEar) {
     EXPECT_TRUE(near(at(placed, 0.0, 6.0), kRed));
     EXPECT_TRUE(near(at(placed, -25.0, 0.0), kGreen)) << "no second ear beside it";
     EXPECT_TRUE(near(at(placed, 90.0, 80.0), kBlue)) << "far from the ear the photo is read where it lies";
+}
+
+// A visitor turned short of the profile: the side photo shows the eye 25 mm further back (and 5 mm lower, where its
+// darkest part lies) than the head's. Read shifted, the photo's eye lands on the head's, and the whole side of the
+// head is read that much further back; up and down only round the eye. Near the midline (the outline, which the fit
+// matched) the photo is read where it lies.
+TEST(PhotoTexture, SidePhotosEyeLandsOnTheHeadsEye) {
+    Mesh mesh;
+    constexpr double half = 100.0;
+    addSquare(mesh, {-60, 0, 0}, {0, 0, 1}, {0, 1, 0}, half, {0.0, 0.0, 1.0, 1.0}, {-1, 0, 0});
+    HeadFit fit = photoFrames();
+    fit.side.mmPerPixel = 0.6;
+    const cv::Mat front(400, 400, CV_8UC3, cv::Scalar(kGreen));
+    const cv::Mat side = paintPhoto(fit, true, [](glm::dvec2 p) {
+        if (glm::distance(p, glm::dvec2(25.0, -5.0)) < 8.0) return kRed;
+        if (glm::distance(p, glm::dvec2(40.0, 80.0)) < 8.0) return kBlue;
+        return kGreen;
+    });
+    const cv::Mat all(400, 400, CV_8U, cv::Scalar(255));
+    PhotoTextureOptions o;
+    o.size = 256;
+    const auto at = [&](const PhotoTexture& t, double z, double y) {
+        const int u = static_cast<int>((z / half + 1.0) / 2.0 * o.size), v = static_cast<int>((1.0 - (y / half + 1.0) / 2.0) * o.size);
+        return cv::Vec3i(t.texture.at<cv::Vec3b>(v, u));
+    };
+    const auto near = [](cv::Vec3i a, cv::Vec3b b) { return cv::norm(a - cv::Vec3i(b)) < 40.0; };
+
+    fit.sideEyeFound = true;
+    fit.eyeMiddleMm = {-60.0, 0.0, 50.0};  // as far off the midline as the square: the whole shift
+    fit.eyeLeftMm = {-25.0, -5.0};
+    const PhotoTexture shifted = textureFromPhotos(mesh, fit, front, all, side, all, o);
+    EXPECT_TRUE(near(at(shifted, 50.0, 0.0), kRed)) << "the photo's eye on the head's";
+    EXPECT_TRUE(near(at(shifted, 25.0, -5.0), kGreen)) << "no second eye behind it";
+    EXPECT_TRUE(near(at(shifted, 65.0, 80.0), kBlue)) << "away from the eye, read as far back, at the same height";
+
+    fit.eyeMiddleMm.x = -600.0;  // the square ten times nearer the midline than the eye: read almost where it lies
+    const PhotoTexture nearMidline = textureFromPhotos(mesh, fit, front, all, side, all, o);
+    EXPECT_TRUE(near(at(nearMidline, 40.0, 80.0), kBlue));
+    EXPECT_TRUE(near(at(nearMidline, 65.0, 80.0), kGreen));
 }
 
 // No photo sees the back of the sphere: it is filled from the colours around it, not left black.

@@ -26,6 +26,8 @@ struct PhotoMeasurements {
     cv::Mat frontHair, sideHair;
     // The middle of the ear in the side photo as taken (fit/face/ear_locator.h), when it was found.
     std::optional<cv::Point2d> sideEar;
+    // The middle of the near eye in the side photo as taken (fit/face/side_eye.h), when it was found.
+    std::optional<cv::Point2d> sideEye;
 };
 
 struct HeadFitOptions {
@@ -123,7 +125,20 @@ struct HeadFit {
     // (PhotoTextureOptions::earReachMm).
     glm::dvec3 earMiddleMm{0.0};
     glm::dvec2 earLeftMm{0.0};
+    // When the side photo's eye was found (and lies within kSideEyeHeightToleranceMm of the head's eye's height):
+    // the right eye's middle on the fitted head (the mean of its six landmark vertices), and how far the side photo's
+    // eye lies from it (side view: forward, up). A visitor turned short of the profile shows the eye further behind
+    // the nose than a profile would, turned past it nearer; the texture reads the side photo shifted by that much
+    // (textureFromPhotos).
+    bool sideEyeFound = false;
+    glm::dvec3 eyeMiddleMm{0.0};
+    glm::dvec2 eyeLeftMm{0.0};
 };
+
+// On FRMDB's profiles the side photo's eye lies 0-16 mm under the head's (its darkest part, the lashes and the iris
+// under the lid, against the six landmarks' middle); further off it was a shadow or hair on synthetic visitors
+// turned 100-110 degrees (18-29 mm).
+inline constexpr double kSideEyeHeightToleranceMm = 17.0;
 
 // Throws BoothError(Mismatch) when the photos disagree (scale ratio, shared heights), NoFace when a needed
 // landmark or outline is missing.

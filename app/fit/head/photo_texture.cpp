@@ -346,15 +346,35 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     };
     const std::vector<glm::dvec3> normals = fitted.vertexNormals();
     const std::vector<glm::dvec3> smooth = smoothedNormals(fitted, normals, kDecisionRings);
-    // The side photo's reading shifted round the ears by what the ears' placement left (both ears: the photo stands in
-    // for the far side too).
+    // Where the side photo is read, shifted from the profile's projection (side view: forward, up):
+    // - Turned short of the profile (or past it), the side photo shows the side of the head further back (or
+    //   forward) than a profile would; the outline, which the fit matched, stays. The side photo's eye measures it
+    //   (HeadFit::eyeLeftMm): the photo is read shifted by that much, sideways only (a turn about the vertical moves
+    //   nothing up or down), from the eye's distance off the midline outwards, and by a share growing from none on
+    //   the midline towards it.
+    // - Round the ears by what the ears' placement left between the head's ear and the photo's (in full within
+    //   earReachMm of the ear's middle, fading out over earFadeMm or twice the shift if more, so that the reading
+    //   cannot fold); both ears, as the photo stands in for the far side too.
+    const auto smoothstep = [](double t) { return t * t * (3.0 - 2.0 * t); };
     const double earFade = std::max(options.earFadeMm, 2.0 * glm::length(fit.earLeftMm));
-    const auto earShift = [&](const glm::dvec3& p) {
-        if (!fit.earsPlaced) return glm::dvec2(0.0);
-        const glm::dvec3& m = fit.earMiddleMm;
-        const glm::dvec3 ear = (p.x < 0.0) == (m.x < 0.0) ? m : glm::dvec3(-m.x, m.y, m.z);
-        const double t = std::clamp((glm::distance(p, ear) - options.earReachMm) / earFade, 0.0, 1.0);
-        return (1.0 - t * t * (3.0 - 2.0 * t)) * fit.earLeftMm;
+    const double eyeOffMidline = std::max(std::abs(fit.eyeMiddleMm.x), 1.0);
+    const auto sideShift = [&](const glm::dvec3& p) {
+        double ear = 0.0;  // the ear's share
+        if (fit.earsPlaced) {
+            const glm::dvec3& m = fit.earMiddleMm;
+            const glm::dvec3 near = (p.x < 0.0) == (m.x < 0.0) ? m : glm::dvec3(-m.x, m.y, m.z);
+            ear = 1.0 - smoothstep(std::clamp((glm::distance(p, near) - options.earReachMm) / earFade, 0.0, 1.0));
+        }
+        glm::dvec2 s = ear * fit.earLeftMm;
+        if (fit.sideEyeFound) {
+            s.x += (1.0 - ear) * smoothstep(std::min(std::abs(p.x) / eyeOffMidline, 1.0)) * fit.eyeLeftMm.x;
+            const glm::dvec3& m = fit.eyeMiddleMm;
+            const glm::dvec3 near = (p.x < 0.0) == (m.x < 0.0) ? m : glm::dvec3(-m.x, m.y, m.z);
+            s.y += (1.0 - smoothstep(std::clamp((glm::distance(p, near) - options.eyeReachMm) /
+                                                std::max(options.eyeFadeMm, 2.0 * std::abs(fit.eyeLeftMm.y)), 0.0, 1.0))) *
+                   fit.eyeLeftMm.y;
+        }
+        return s;
     };
     std::vector<VertexViews> views(fitted.positions.size());
     std::array<std::vector<ViewVertex>, 3> depthVertices;  // front, from -x, from +x
@@ -362,7 +382,7 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     for (std::size_t i = 0; i < fitted.positions.size(); ++i) {
         const glm::dvec3& p = fitted.positions[i];
         const cv::Point2d f = fit.front.toPixel({p.x, p.y});
-        const cv::Point2d s = fit.side.toPixel(glm::dvec2(p.z, p.y) + earShift(p));
+        const cv::Point2d s = fit.side.toPixel(glm::dvec2(p.z, p.y) + sideShift(p));
         const glm::dvec3& n = normals[i];
         const glm::dvec3& m = smooth[i];
         VertexViews& v = views[i];

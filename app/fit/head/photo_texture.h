@@ -19,18 +19,20 @@ struct PhotoTextureOptions {
     // (with frontPreference) which of the two photos a texel both see takes.
     double angleStrictness = 2.0;
     // How much the front photo is preferred: a texel both photos see goes to the side photo only where the side
-    // weight exceeds frontPreference times the front weight (with cos^2 weights and 4: where the surface turns more
-    // than about 63 degrees from the front). The front photo is registered by 68 landmarks in (x, y); the side
+    // weight exceeds frontPreference times the front weight (with cos^2 weights and 1.5: where the surface turns more
+    // than about 51 degrees from the front). The front photo is registered by 68 landmarks in (x, y); the side
     // photo's colour lands through the fitted depth z, which off the profile line is the base head's guess, so on
-    // the face (cheeks by the nose and mouth) it is the less trustworthy of the two.
-    double frontPreference = 4.0;
-    // Round the eyes and brows (TextureTables' front features) the front photo is preferred more: there the side
-    // photo lands through the fitted depth of the eye's corner and the brow's tail, and a few millimetres off it put
-    // a second brow tail and eye corner onto the temple (FRMDB 001, 002, 003). With 40 the side photo takes over
-    // only where the surface turns more than about 81 degrees from the front (16, 76 degrees, left a fainter ghost of
-    // 003's eye corner). Full within featureReachMm of a feature vertex, fading to frontPreference over the next
-    // featureFadeMm.
-    double featureFrontPreference = 40.0;
+    // the face (cheeks by the nose and mouth) it is the less trustworthy of the two. But the nearer the seam comes
+    // to where the surface faces the front camera and not the side's, the darker the front photo's side of it
+    // (the booth's light comes from the cameras): with 4 (63 degrees) every FRMDB profile showed a dark band down
+    // the cheek from the brow to the jaw, 003's as a line; at 1.5 it is gone from all but the darkest-shaded fronts.
+    double frontPreference = 1.5;
+    // Round the eyes and brows (TextureTables' front features) the front photo is preferred more: there a side
+    // photo's eye corner or brow tail a few millimetres off the head's is a second one on the temple. 4 puts the
+    // seam there at about 63 degrees. (It was 40, 81 degrees, before the side photo was read shifted by its eye's
+    // offset, HeadFit::eyeLeftMm: the front photo's darkest band then ran from the brow to the cheek.) Full within
+    // featureReachMm of a feature vertex, fading to frontPreference over the next featureFadeMm.
+    double featureFrontPreference = 4.0;
     double featureReachMm = 25.0;
     double featureFadeMm = 15.0;
     // Bands of the multi-band blend across the seam (more = a wider, softer transition of the low frequencies): the
@@ -44,6 +46,10 @@ struct PhotoTextureOptions {
     // smoothly over earFadeMm, or over twice the shift if that is more (so that the shifted reading cannot fold).
     double earReachMm = 30.0;
     double earFadeMm = 40.0;
+    // Up or down, the side photo's eye is read where it lies off the head's (HeadFit::eyeLeftMm) round the eye only:
+    // in full within eyeReachMm of its middle, fading out over eyeFadeMm (or twice the shift if more).
+    double eyeReachMm = 12.0;
+    double eyeFadeMm = 20.0;
 };
 
 struct PhotoTexture {
