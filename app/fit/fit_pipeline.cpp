@@ -231,8 +231,19 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     // The photos' hair, for the texture's exposure match (skin against skin) and the short hair's trim.
     if (out.hair.style != HairStyle::None && m.frontHair.empty()) m.frontHair = hairPixels(front, out.frontMask, out.hair);
     out.texture = runStep(out, control, FitStep::Texture, names, [&] {
-        return textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask, settings_.texture,
-                                 *textureTables_, ColourMatchMasks{m.frontHair, m.sideHair});
+        PhotoTexture texture = textureFromPhotos(out.fit.mesh, out.fit, front, out.frontMask, side, out.sideMask,
+                                                 settings_.texture, *textureTables_, ColourMatchMasks{m.frontHair, m.sideHair});
+        if (hairCoversEars(out.hair.style)) {
+            // Long hair or a bob beside the face: the hair part leaves the cheeks bare, so the photo's hair on them goes.
+            const auto at = [&](int k) { return out.fit.mesh.positions[base_.frontFeatures.at(landmarkName(k))]; };
+            FaceSides sides;
+            sides.innerX = 0.5 * (std::abs(at(36).x) + std::abs(at(45).x));
+            sides.topY = -1e9;
+            for (int k = 17; k <= 26; ++k) sides.topY = std::max(sides.topY, at(k).y);
+            sides.bottomY = out.hair.beard ? at(30).y : at(8).y;
+            out.skinOverHairTexels = skinOverHairBesideFace(texture, out.fit.mesh, out.fit, m.frontHair, sides, *textureTables_);
+        }
+        return texture;
     });
     out.partColours = measurePartColours(front, out.frontLandmarks);
     out.parts = placeParts(base_, out.fit.mesh, out.texture.texture, out.partColours);

@@ -8,6 +8,7 @@
 #include "common/landmark_names.h"
 #include "fit/fit_pipeline.h"
 #include "fit/head/folds.h"
+#include "fit/parts/hair_part.h"
 #include "render/mesh_renderer.h"
 
 #include <gtest/gtest.h>
@@ -259,6 +260,11 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
     const double floor = outcome.hair.style == HairStyle::Short ? 0.85 : 0.75;
     EXPECT_GT(frontAgreement, floor);
     EXPECT_GT(sideAgreement, floor);
+    std::printf("%s %s: %d texels of the photo's hair beside the face repainted with skin\n", person,
+                std::get<1>(GetParam()), outcome.skinOverHairTexels);
+    if (!hairCoversEars(outcome.hair.style)) {
+        EXPECT_EQ(outcome.skinOverHairTexels, 0);
+    }
     std::printf("%s %s: parts", person, std::get<1>(GetParam()));
     for (const auto& part : outcome.parts) std::printf(" %s", part.name.c_str());
     for (const auto& [name, c] : outcome.partColours) std::printf("; %s (%.0f %.0f %.0f)", name.c_str(), c[0], c[1], c[2]);

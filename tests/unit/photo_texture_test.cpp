@@ -447,6 +447,46 @@ TEST(PhotoTexture, SidePhotosEyeLandsOnTheHeadsEye) {
     EXPECT_TRUE(near(at(nearMidline, 65.0, 80.0), kGreen));
 }
 
+// Hair the front photo shows over the face's sides (blue, marked not-skin) is repainted with the skin round it (green)
+// where the sides are (outward of 40 mm, between 50 mm down and up); inside them (the brows and eyes, which count as
+// hair too) and above them (the hairline) it stays.
+TEST(PhotoTexture, HairBesideTheFaceIsRepaintedWithSkin) {
+    Mesh mesh;
+    constexpr double half = 90.0;
+    addSquare(mesh, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, half, {0.0, 0.0, 1.0, 1.0}, {0, 0, 1});
+    const HeadFit fit = photoFrames();
+    const auto hairAt = [](glm::dvec2 p) { return std::abs(p.x) > 60.0 || std::abs(p.x) < 10.0; };
+    const cv::Mat front = paintPhoto(fit, false, [&](glm::dvec2 p) { return hairAt(p) ? kBlue : kGreen; });
+    cv::Mat frontHair(400, 400, CV_8U);
+    for (int v = 0; v < 400; ++v)
+        for (int u = 0; u < 400; ++u) frontHair.at<unsigned char>(v, u) = hairAt(fit.front.toHead(cv::Point2d(u, v))) ? 255 : 0;
+    const cv::Mat side(400, 400, CV_8UC3, cv::Scalar(kRed));
+    const cv::Mat all(400, 400, CV_8U, cv::Scalar(255));
+    PhotoTextureOptions o;
+    o.size = 256;
+    const TextureTables tables(mesh, o);
+    PhotoTexture t = textureFromPhotos(mesh, fit, front, all, side, all, o, tables);
+    const auto at = [&](double x, double y) {
+        const int u = static_cast<int>((x / half + 1.0) / 2.0 * o.size), v = static_cast<int>((1.0 - (y / half + 1.0) / 2.0) * o.size);
+        return cv::Vec3i(t.texture.at<cv::Vec3b>(v, u));
+    };
+    const auto near = [](cv::Vec3i a, cv::Vec3b b) { return cv::norm(a - cv::Vec3i(b)) < 40.0; };
+    ASSERT_TRUE(near(at(75.0, 0.0), kBlue)) << "the photo's hair, before";
+
+    FaceSides sides;
+    sides.innerX = 40.0;
+    sides.bottomY = -50.0;
+    sides.topY = 50.0;
+    const int repainted = skinOverHairBesideFace(t, mesh, fit, frontHair, sides, tables);
+    EXPECT_GT(repainted, 0);
+    for (const double x : {-80.0, -70.0, 70.0, 80.0})
+        for (const double y : {-40.0, 0.0, 40.0}) EXPECT_TRUE(near(at(x, y), kGreen)) << "skin at " << x << ", " << y;
+    EXPECT_TRUE(near(at(0.0, 0.0), kBlue)) << "inside the sides it stays";
+    EXPECT_TRUE(near(at(75.0, 75.0), kBlue)) << "above them it stays";
+    EXPECT_TRUE(near(at(30.0, 0.0), kGreen));
+    EXPECT_EQ(skinOverHairBesideFace(t, mesh, fit, cv::Mat(), sides, tables), 0) << "no hair known, nothing repainted";
+}
+
 // No photo sees the back of the sphere: it is filled from the colours around it, not left black.
 TEST(PhotoTexture, UnseenTexelsAreFilledWithSurroundingColours) {
     const Mesh sphere = uvSphere(kRadius);

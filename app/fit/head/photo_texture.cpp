@@ -632,6 +632,62 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     return out;
 }
 
+int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const cv::Mat& frontNotSkin,
+                           const FaceSides& sides, const TextureTables& tables) {
+    if (frontNotSkin.empty()) return 0;
+    if (texture.texture.size() != tables.full().size || !tables.fits(fitted))
+        throw BoothError(ErrorKind::Internal, "", "texture: the texel tables were made for another mesh or size");
+    const TexelMap& map = tables.full();
+    const cv::Size size = map.size;
+    // Each texel that took the front photo: skin (a source of the fill) or hair on the face's sides (repainted).
+    cv::Mat colour(size, CV_32FC3, cv::Scalar::all(0)), weight(size, CV_32F, cv::Scalar(0));
+    cv::Mat target(size, CV_8U, cv::Scalar(0));
+    int repainted = 0;
+    for (int y = 0; y < size.height; ++y) {
+        const int* tri = map.triangle.ptr<int>(y);
+        const unsigned char* src = texture.source.ptr<unsigned char>(y);
+        for (int x = 0; x < size.width; ++x) {
+            if (tri[x] < 0 || src[x] != PhotoTexture::Front) continue;
+            const glm::uvec3& t = fitted.triangles[static_cast<std::size_t>(tri[x])];
+            const cv::Vec2d b = map.barycentric(tri[x], x, y);
+            const glm::dvec3 p = b[0] * fitted.positions[t.x] + b[1] * fitted.positions[t.y] +
+                                 (1.0 - b[0] - b[1]) * fitted.positions[t.z];
+            const cv::Point2d px = fit.front.toPixel({p.x, p.y});
+            if (isSkin(frontNotSkin, static_cast<float>(px.x), static_cast<float>(px.y))) {
+                const cv::Vec3b c = texture.texture.at<cv::Vec3b>(y, x);
+                colour.at<cv::Vec3f>(y, x) = cv::Vec3f(c[0], c[1], c[2]);
+                weight.at<float>(y, x) = 1.0f;
+            } else if (std::abs(p.x) >= sides.innerX && p.y >= sides.bottomY && p.y <= sides.topY) {
+                target.at<unsigned char>(y, x) = 255;
+                ++repainted;
+            }
+        }
+    }
+    if (repainted == 0 || cv::countNonZero(weight) == 0) return 0;
+    pullPushFill(colour, weight);
+    // Feathered over a few texels, so that no hard edge is left where the photo's hair ended.
+    cv::Mat full, blend;
+    target.convertTo(full, CV_32F, 1.0 / 255.0);
+    cv::GaussianBlur(full, blend, cv::Size(), std::max(1.0, size.width / 512.0));
+    cv::max(blend, full, blend);
+    const cv::Mat& detail = tables.skinDetail();
+    for (int y = 0; y < size.height; ++y) {
+        const int* tri = map.triangle.ptr<int>(y);
+        const float* w = blend.ptr<float>(y);
+        cv::Vec3b* o = texture.texture.ptr<cv::Vec3b>(y);
+        for (int x = 0; x < size.width; ++x) {
+            if (tri[x] < 0 || w[x] <= 0.0f) continue;
+            cv::Vec3f skin = colour.at<cv::Vec3f>(y, x);
+            if (!detail.empty()) {
+                const cv::Vec<schar, 3> d = detail.at<cv::Vec<schar, 3>>(y, x);
+                skin += cv::Vec3f(d[0], d[1], d[2]);
+            }
+            for (int c = 0; c < 3; ++c) o[x][c] = cv::saturate_cast<unsigned char>(w[x] * skin[c] + (1.0f - w[x]) * o[x][c]);
+        }
+    }
+    return repainted;
+}
+
 void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& detail) {
     if (texture.texture.empty() || detail.empty() || detail.size() != texture.texture.size()) return;
     if (detail.type() != CV_8SC3) throw BoothError(ErrorKind::Internal, "", "texture: the skin detail must be CV_8SC3");
