@@ -96,6 +96,31 @@ cv::Mat uvRegion(int size, cv::Rect2d uv) {
     return mask;
 }
 
+// Within 40 levels of a colour (the bilinear reading and the blend soften edges).
+bool nearColour(cv::Vec3i a, cv::Vec3b b) { return cv::norm(a - cv::Vec3i(b)) < 40.0; }
+
+// A 200 mm square facing -x at x = -60, seen squarely by the side photo (0.6 mm a pixel: the square fills its 400
+// pixels) and edge-on by the front one, which is all green.
+struct SideSquare {
+    static constexpr double half = 100.0;
+    Mesh mesh;
+    HeadFit fit = photoFrames();
+    cv::Mat front{400, 400, CV_8UC3, cv::Scalar(kGreen)}, all{400, 400, CV_8U, cv::Scalar(255)};
+    PhotoTextureOptions options;
+    SideSquare() {
+        addSquare(mesh, {-60, 0, 0}, {0, 0, 1}, {0, 1, 0}, half, {0.0, 0.0, 1.0, 1.0}, {-1, 0, 0});
+        fit.side.mmPerPixel = 0.6;
+        options.size = 256;
+    }
+    PhotoTexture texture(const cv::Mat& side) const { return textureFromPhotos(mesh, fit, front, all, side, all, options); }
+    // The colour of the texel of the square's point (z, y).
+    cv::Vec3i at(const PhotoTexture& t, double z, double y) const {
+        const int u = static_cast<int>((z / half + 1.0) / 2.0 * options.size);
+        const int v = static_cast<int>((1.0 - (y / half + 1.0) / 2.0) * options.size);
+        return cv::Vec3i(t.texture.at<cv::Vec3b>(v, u));
+    }
+};
+
 }  // namespace
 
 // Two parallel squares facing the front camera: a small one 20 mm in front of a large one. The front photo shows
@@ -373,39 +398,24 @@ TEST(PhotoTexture, FrontPhotoIsPreferredRoundFrontFeatures) {
 // the head's ear the side photo is read shifted by that, so that the photo's ear (a red disc) lands on the head's ear
 // (the side-facing square's middle) and not beside it; far from the ear the photo is read where it lies (a blue disc).
 TEST(PhotoTexture, SidePhotosEarLandsOnTheHeadsEar) {
-    Mesh mesh;
-    constexpr double half = 100.0;
-    addSquare(mesh, {-60, 0, 0}, {0, 0, 1}, {0, 1, 0}, half, {0.0, 0.0, 1.0, 1.0}, {-1, 0, 0});
-    HeadFit fit = photoFrames();
-    fit.side.mmPerPixel = 0.6;  // the square's 200 mm in the photo's 400 pixels
-    const cv::Mat front(400, 400, CV_8UC3, cv::Scalar(kGreen));
-    const cv::Mat side = paintPhoto(fit, true, [](glm::dvec2 p) {
+    SideSquare square;
+    const cv::Mat side = paintPhoto(square.fit, true, [](glm::dvec2 p) {
         if (glm::distance(p, glm::dvec2(-25.0, 0.0)) < 10.0) return kRed;
         if (glm::distance(p, glm::dvec2(90.0, 80.0)) < 8.0) return kBlue;
         return kGreen;
     });
-    const cv::Mat all(400, 400, CV_8U, cv::Scalar(255));
-    PhotoTextureOptions o;
-    o.size = 256;
-    // The texel of the square's point (z, y), and its colour.
-    const auto at = [&](const PhotoTexture& t, double z, double y) {
-        const int u = static_cast<int>((z / half + 1.0) / 2.0 * o.size), v = static_cast<int>((1.0 - (y / half + 1.0) / 2.0) * o.size);
-        return cv::Vec3i(t.texture.at<cv::Vec3b>(v, u));
-    };
-    const auto near = [](cv::Vec3i a, cv::Vec3b b) { return cv::norm(a - cv::Vec3i(b)) < 40.0; };
+    const PhotoTexture unplaced = square.texture(side);
+    EXPECT_TRUE(nearColour(square.at(unplaced, -25.0, 0.0), kRed)) << "without a placement the photo is read where it lies";
+    EXPECT_TRUE(nearColour(square.at(unplaced, 0.0, 0.0), kGreen));
 
-    const PhotoTexture unplaced = textureFromPhotos(mesh, fit, front, all, side, all, o);
-    EXPECT_TRUE(near(at(unplaced, -25.0, 0.0), kRed)) << "without a placement the photo is read where it lies";
-    EXPECT_TRUE(near(at(unplaced, 0.0, 0.0), kGreen));
-
-    fit.earsPlaced = true;
-    fit.earMiddleMm = {-60.0, 0.0, 0.0};
-    fit.earLeftMm = {-25.0, 0.0};
-    const PhotoTexture placed = textureFromPhotos(mesh, fit, front, all, side, all, o);
-    EXPECT_TRUE(near(at(placed, 0.0, 0.0), kRed)) << "the photo's ear on the head's ear";
-    EXPECT_TRUE(near(at(placed, 0.0, 6.0), kRed));
-    EXPECT_TRUE(near(at(placed, -25.0, 0.0), kGreen)) << "no second ear beside it";
-    EXPECT_TRUE(near(at(placed, 90.0, 80.0), kBlue)) << "far from the ear the photo is read where it lies";
+    square.fit.earsPlaced = true;
+    square.fit.earMiddleMm = {-60.0, 0.0, 0.0};
+    square.fit.earLeftMm = {-25.0, 0.0};
+    const PhotoTexture placed = square.texture(side);
+    EXPECT_TRUE(nearColour(square.at(placed, 0.0, 0.0), kRed)) << "the photo's ear on the head's ear";
+    EXPECT_TRUE(nearColour(square.at(placed, 0.0, 6.0), kRed));
+    EXPECT_TRUE(nearColour(square.at(placed, -25.0, 0.0), kGreen)) << "no second ear beside it";
+    EXPECT_TRUE(nearColour(square.at(placed, 90.0, 80.0), kBlue)) << "far from the ear the photo is read where it lies";
 }
 
 // A visitor turned short of the profile: the side photo shows the eye 25 mm further back (and 5 mm lower, where its
@@ -413,38 +423,24 @@ TEST(PhotoTexture, SidePhotosEarLandsOnTheHeadsEar) {
 // head is read that much further back; up and down only round the eye. Near the midline (the outline, which the fit
 // matched) the photo is read where it lies.
 TEST(PhotoTexture, SidePhotosEyeLandsOnTheHeadsEye) {
-    Mesh mesh;
-    constexpr double half = 100.0;
-    addSquare(mesh, {-60, 0, 0}, {0, 0, 1}, {0, 1, 0}, half, {0.0, 0.0, 1.0, 1.0}, {-1, 0, 0});
-    HeadFit fit = photoFrames();
-    fit.side.mmPerPixel = 0.6;
-    const cv::Mat front(400, 400, CV_8UC3, cv::Scalar(kGreen));
-    const cv::Mat side = paintPhoto(fit, true, [](glm::dvec2 p) {
+    SideSquare square;
+    const cv::Mat side = paintPhoto(square.fit, true, [](glm::dvec2 p) {
         if (glm::distance(p, glm::dvec2(25.0, -5.0)) < 8.0) return kRed;
         if (glm::distance(p, glm::dvec2(40.0, 80.0)) < 8.0) return kBlue;
         return kGreen;
     });
-    const cv::Mat all(400, 400, CV_8U, cv::Scalar(255));
-    PhotoTextureOptions o;
-    o.size = 256;
-    const auto at = [&](const PhotoTexture& t, double z, double y) {
-        const int u = static_cast<int>((z / half + 1.0) / 2.0 * o.size), v = static_cast<int>((1.0 - (y / half + 1.0) / 2.0) * o.size);
-        return cv::Vec3i(t.texture.at<cv::Vec3b>(v, u));
-    };
-    const auto near = [](cv::Vec3i a, cv::Vec3b b) { return cv::norm(a - cv::Vec3i(b)) < 40.0; };
+    square.fit.sideEyeFound = true;
+    square.fit.eyeMiddleMm = {-60.0, 0.0, 50.0};  // as far off the midline as the square: the whole shift
+    square.fit.eyeLeftMm = {-25.0, -5.0};
+    const PhotoTexture shifted = square.texture(side);
+    EXPECT_TRUE(nearColour(square.at(shifted, 50.0, 0.0), kRed)) << "the photo's eye on the head's";
+    EXPECT_TRUE(nearColour(square.at(shifted, 25.0, -5.0), kGreen)) << "no second eye behind it";
+    EXPECT_TRUE(nearColour(square.at(shifted, 65.0, 80.0), kBlue)) << "away from the eye, read as far back, at the same height";
 
-    fit.sideEyeFound = true;
-    fit.eyeMiddleMm = {-60.0, 0.0, 50.0};  // as far off the midline as the square: the whole shift
-    fit.eyeLeftMm = {-25.0, -5.0};
-    const PhotoTexture shifted = textureFromPhotos(mesh, fit, front, all, side, all, o);
-    EXPECT_TRUE(near(at(shifted, 50.0, 0.0), kRed)) << "the photo's eye on the head's";
-    EXPECT_TRUE(near(at(shifted, 25.0, -5.0), kGreen)) << "no second eye behind it";
-    EXPECT_TRUE(near(at(shifted, 65.0, 80.0), kBlue)) << "away from the eye, read as far back, at the same height";
-
-    fit.eyeMiddleMm.x = -600.0;  // the square ten times nearer the midline than the eye: read almost where it lies
-    const PhotoTexture nearMidline = textureFromPhotos(mesh, fit, front, all, side, all, o);
-    EXPECT_TRUE(near(at(nearMidline, 40.0, 80.0), kBlue));
-    EXPECT_TRUE(near(at(nearMidline, 65.0, 80.0), kGreen));
+    square.fit.eyeMiddleMm.x = -600.0;  // the square ten times nearer the midline than the eye: read almost where it lies
+    const PhotoTexture nearMidline = square.texture(side);
+    EXPECT_TRUE(nearColour(square.at(nearMidline, 40.0, 80.0), kBlue));
+    EXPECT_TRUE(nearColour(square.at(nearMidline, 65.0, 80.0), kGreen));
 }
 
 // Hair the front photo shows over the face's sides (blue, marked not-skin) is repainted with the skin round it (green)
@@ -470,8 +466,7 @@ TEST(PhotoTexture, HairBesideTheFaceIsRepaintedWithSkin) {
         const int u = static_cast<int>((x / half + 1.0) / 2.0 * o.size), v = static_cast<int>((1.0 - (y / half + 1.0) / 2.0) * o.size);
         return cv::Vec3i(t.texture.at<cv::Vec3b>(v, u));
     };
-    const auto near = [](cv::Vec3i a, cv::Vec3b b) { return cv::norm(a - cv::Vec3i(b)) < 40.0; };
-    ASSERT_TRUE(near(at(75.0, 0.0), kBlue)) << "the photo's hair, before";
+    ASSERT_TRUE(nearColour(at(75.0, 0.0), kBlue)) << "the photo's hair, before";
 
     FaceSides sides;
     sides.innerX = 40.0;
@@ -480,10 +475,10 @@ TEST(PhotoTexture, HairBesideTheFaceIsRepaintedWithSkin) {
     const int repainted = skinOverHairBesideFace(t, mesh, fit, frontHair, sides, tables);
     EXPECT_GT(repainted, 0);
     for (const double x : {-80.0, -70.0, 70.0, 80.0})
-        for (const double y : {-40.0, 0.0, 40.0}) EXPECT_TRUE(near(at(x, y), kGreen)) << "skin at " << x << ", " << y;
-    EXPECT_TRUE(near(at(0.0, 0.0), kBlue)) << "inside the sides it stays";
-    EXPECT_TRUE(near(at(75.0, 75.0), kBlue)) << "above them it stays";
-    EXPECT_TRUE(near(at(30.0, 0.0), kGreen));
+        for (const double y : {-40.0, 0.0, 40.0}) EXPECT_TRUE(nearColour(at(x, y), kGreen)) << "skin at " << x << ", " << y;
+    EXPECT_TRUE(nearColour(at(0.0, 0.0), kBlue)) << "inside the sides it stays";
+    EXPECT_TRUE(nearColour(at(75.0, 75.0), kBlue)) << "above them it stays";
+    EXPECT_TRUE(nearColour(at(30.0, 0.0), kGreen));
     EXPECT_EQ(skinOverHairBesideFace(t, mesh, fit, cv::Mat(), sides, tables), 0) << "no hair known, nothing repainted";
 }
 
