@@ -639,33 +639,18 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
         throw BoothError(ErrorKind::Internal, "", "texture: the texel tables were made for another mesh or size");
     const TexelMap& map = tables.full();
     const cv::Size size = map.size;
-    // Only the part of the texture round the face's sides is looked at: the UV box of the triangles there, with a
-    // margin for the skin the fill continues from.
-    const auto onSides = [&](const glm::dvec3& p, double margin) {
-        return std::abs(p.x) >= sides.innerX - margin && p.y >= sides.bottomY - margin && p.y <= sides.topY + margin;
+    const auto onSides = [&](const glm::dvec3& p) {
+        return std::abs(p.x) >= sides.innerX && p.y >= sides.bottomY && p.y <= sides.topY;
     };
-    cv::Rect box;
-    for (const glm::uvec3& t : fitted.triangles) {
-        if (!onSides(fitted.positions[t.x], 5.0) && !onSides(fitted.positions[t.y], 5.0) && !onSides(fitted.positions[t.z], 5.0))
-            continue;
-        for (const std::uint32_t v : {t.x, t.y, t.z}) {
-            const cv::Rect texel(static_cast<int>(fitted.uvs[v].x * size.width), static_cast<int>(fitted.uvs[v].y * size.height), 1, 1);
-            box = box.empty() ? texel : (box | texel);
-        }
-    }
-    const int margin = size.width / 16;
-    box = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) & cv::Rect(cv::Point(), size);
-    if (box.empty()) return 0;
-    // Each texel there that took the front photo: skin (a source of the fill) or hair on the face's sides (repainted).
-    cv::Mat colour(box.size(), CV_32FC3, cv::Scalar::all(0)), weight(box.size(), CV_32F, cv::Scalar(0));
-    cv::Mat target(box.size(), CV_8U, cv::Scalar(0));
-    cv::parallel_for_(cv::Range(0, box.height), [&](const cv::Range& rows) {
-        for (int r = rows.start; r < rows.end; ++r) {
-            const int y = box.y + r;
+    // Each texel that took the front photo: skin (a source of the fill) or hair on the face's sides (repainted).
+    cv::Mat colour(size, CV_32FC3, cv::Scalar::all(0)), weight(size, CV_32F, cv::Scalar(0));
+    cv::Mat target(size, CV_8U, cv::Scalar(0));
+    cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
+        for (int y = rows.start; y < rows.end; ++y) {
             const int* tri = map.triangle.ptr<int>(y);
             const unsigned char* src = texture.source.ptr<unsigned char>(y);
             const cv::Vec3b* in = texture.texture.ptr<cv::Vec3b>(y);
-            for (int x = box.x; x < box.x + box.width; ++x) {
+            for (int x = 0; x < size.width; ++x) {
                 if (tri[x] < 0 || src[x] != PhotoTexture::Front) continue;
                 const glm::uvec3& t = fitted.triangles[static_cast<std::size_t>(tri[x])];
                 const cv::Vec2d b = map.barycentric(tri[x], x, y);
@@ -673,10 +658,10 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
                                      (1.0 - b[0] - b[1]) * fitted.positions[t.z];
                 const cv::Point2d px = fit.front.toPixel({p.x, p.y});
                 if (isSkin(frontNotSkin, static_cast<float>(px.x), static_cast<float>(px.y))) {
-                    colour.at<cv::Vec3f>(r, x - box.x) = cv::Vec3f(in[x][0], in[x][1], in[x][2]);
-                    weight.at<float>(r, x - box.x) = 1.0f;
-                } else if (onSides(p, 0.0)) {
-                    target.at<unsigned char>(r, x - box.x) = 255;
+                    colour.at<cv::Vec3f>(y, x) = cv::Vec3f(in[x][0], in[x][1], in[x][2]);
+                    weight.at<float>(y, x) = 1.0f;
+                } else if (onSides(p)) {
+                    target.at<unsigned char>(y, x) = 255;
                 }
             }
         }
@@ -687,7 +672,7 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
     // resolution), and the edge feathered over a few texels there, so that no hard edge is left where the photo's
     // hair ended.
     cv::Mat smallColour, smallWeight, smallTarget;
-    const cv::Size small((box.width + 3) / 4, (box.height + 3) / 4);
+    const cv::Size small((size.width + 3) / 4, (size.height + 3) / 4);
     cv::resize(colour, smallColour, small, 0, 0, cv::INTER_AREA);
     cv::resize(weight, smallWeight, small, 0, 0, cv::INTER_AREA);
     for (int y = 0; y < small.height; ++y)
@@ -709,16 +694,15 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
                  ay * ((1.0f - ax) * m.at<V>(y1, x0) + ax * m.at<V>(y1, x1)));
     };
     const cv::Mat& detail = tables.skinDetail();
-    for (int r = 0; r < box.height; ++r) {
-        const int y = box.y + r;
+    for (int y = 0; y < size.height; ++y) {
         const int* tri = map.triangle.ptr<int>(y);
-        const unsigned char* t = target.ptr<unsigned char>(r);
+        const unsigned char* t = target.ptr<unsigned char>(y);
         cv::Vec3b* o = texture.texture.ptr<cv::Vec3b>(y);
-        for (int x = box.x; x < box.x + box.width; ++x) {
+        for (int x = 0; x < size.width; ++x) {
             if (tri[x] < 0) continue;
-            const float wx = t[x - box.x] ? 1.0f : mix(smallTarget, 0.0f, x - box.x, r);
+            const float wx = t[x] ? 1.0f : mix(smallTarget, 0.0f, x, y);
             if (wx <= 0.0f) continue;
-            cv::Vec3f skin = mix(smallColour, cv::Vec3f(), x - box.x, r);
+            cv::Vec3f skin = mix(smallColour, cv::Vec3f(), x, y);
             if (!detail.empty()) {
                 const cv::Vec<schar, 3> d = detail.at<cv::Vec<schar, 3>>(y, x);
                 skin += cv::Vec3f(d[0], d[1], d[2]);
