@@ -92,7 +92,7 @@ TEST(ProfileTurn, DegreesPastTheProfileFromTheEarsShare) {
     EXPECT_DOUBLE_EQ(degreesPastProfile(ear), 0.0);
 }
 
-TEST(TurnedShortCues, NeedTheEyeWellShortAndTheEarFarBackOrUnseen) {
+TEST(TurnedShortCues, NeedTheEyeWellShortAndTheEarFarBackOrTheEyeShortAndNoEar) {
     ProfileTurn turn;
     turn.known = true;
     turn.degrees = -25.0;  // exactly kEyeTurnMoreDegrees
@@ -107,8 +107,14 @@ TEST(TurnedShortCues, NeedTheEyeWellShortAndTheEarFarBackOrUnseen) {
     ear.ear.front = 0.66 * 1.4;
     EXPECT_FALSE(turnedShortCues(ear)) << "the ear nearer the face than at 60 degrees";
     ProfileTurn unseen = turn;
-    unseen.ear.found = false;  // a dark or textured cheek: the eye and the face decide
+    unseen.ear.found = false;  // a dark or textured cheek: the eye and the face decide, the eye from 20 degrees short
     EXPECT_TRUE(turnedShortCues(unseen));
+    unseen.degrees = -20.0;  // exactly kEyeTurnMoreNoEarDegrees (a dark-skinned visitor at 60 degrees: -22)
+    EXPECT_TRUE(turnedShortCues(unseen));
+    unseen.degrees = -19.9;
+    EXPECT_FALSE(turnedShortCues(unseen));
+    eye.ear.found = false;
+    EXPECT_TRUE(turnedShortCues(eye)) << "without an ear, -24.9 is short enough";
     ProfileTurn unknown = turn;
     unknown.known = false;
     EXPECT_FALSE(turnedShortCues(unknown)) << "no eye read: nothing to say";

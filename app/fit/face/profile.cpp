@@ -708,8 +708,10 @@ bool turnedPastProfile(double eyeDegrees, const EarPlace& ear) {
 }
 
 bool turnedShortCues(const ProfileTurn& turn) {
-    if (!turn.known || turn.degrees > kEyeTurnMoreDegrees) return false;
-    return !turn.ear.found || (turn.ear.headLength > 0.0 && turn.ear.front / turn.ear.headLength >= kEarShareTurnMore);
+    if (!turn.known) return false;
+    if (!turn.ear.found) return turn.degrees <= kEyeTurnMoreNoEarDegrees;
+    if (turn.degrees > kEyeTurnMoreDegrees) return false;
+    return turn.ear.headLength > 0.0 && turn.ear.front / turn.ear.headLength >= kEarShareTurnMore;
 }
 
 ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, const std::vector<ProfilePoint>& landmarks,

@@ -115,11 +115,14 @@ double degreesPastProfile(const EarPlace& ear);
 
 // Whether the eye and the ear both say the head is turned well short of the profile (about 60 degrees from the
 // front): the eye kEyeTurnMoreDegrees or more short, and the ear's front at kEarShareTurnMore of the head's length
-// or more behind the nose tip (or not found: a dark or textured cheek). On its own it is not enough (a visitor at 70
-// degrees reads -24 by the eye, 0.69 by the ear): the caller then looks for the face with dlib's detector, whose
-// filters for faces looking aside find it at 55-66 degrees and not past the profile (README, issue 22). Pure.
+// or more behind the nose tip; or, where no ear was found (a dark or textured cheek, hair), the eye
+// kEyeTurnMoreNoEarDegrees or more short (a dark-skinned synthetic visitor at 60 degrees reads -22; none of those
+// without an ear at 70-110 degrees reads under -15). On its own it is not enough (a visitor at 70 degrees reads -24
+// by the eye, 0.69 by the ear): the caller then looks for the face with dlib's detector, whose filters for faces
+// looking aside find it at 55-66 degrees and not past the profile (README, issue 22). Pure.
 bool turnedShortCues(const ProfileTurn& turn);
 inline constexpr double kEyeTurnMoreDegrees = -25.0;
+inline constexpr double kEyeTurnMoreNoEarDegrees = -20.0;
 inline constexpr double kEarShareTurnMore = 0.67;
 
 struct SideAnalysis {
