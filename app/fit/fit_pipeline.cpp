@@ -241,7 +241,10 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
             sides.topY = -1e9;
             for (int k = 17; k <= 26; ++k) sides.topY = std::max(sides.topY, at(k).y);
             sides.bottomY = out.hair.beard ? at(30).y : at(8).y;
-            out.skinOverHairTexels = skinOverHairBesideFace(texture, out.fit.mesh, out.fit, m.frontHair, sides, *textureTables_);
+            // The head's origin lies between the ear holes; the ear reaches about 15 mm ahead of its middle.
+            sides.frontOfZ = (out.fit.earsPlaced ? out.fit.earMiddleMm.z : 0.0) + 15.0;
+            out.skinOverHairTexels = skinOverHairBesideFace(texture, out.fit.mesh, out.fit, ColourMatchMasks{m.frontHair, m.sideHair},
+                                                            sides, settings_.texture, *textureTables_);
         }
         return texture;
     });

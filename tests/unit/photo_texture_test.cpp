@@ -472,14 +472,38 @@ TEST(PhotoTexture, HairBesideTheFaceIsRepaintedWithSkin) {
     sides.innerX = 40.0;
     sides.bottomY = -50.0;
     sides.topY = 50.0;
-    const int repainted = skinOverHairBesideFace(t, mesh, fit, frontHair, sides, tables);
+    const int repainted = skinOverHairBesideFace(t, mesh, fit, ColourMatchMasks{frontHair, {}}, sides, o, tables);
     EXPECT_GT(repainted, 0);
     for (const double x : {-80.0, -70.0, 70.0, 80.0})
         for (const double y : {-40.0, 0.0, 40.0}) EXPECT_TRUE(nearColour(at(x, y), kGreen)) << "skin at " << x << ", " << y;
     EXPECT_TRUE(nearColour(at(0.0, 0.0), kBlue)) << "inside the sides it stays";
     EXPECT_TRUE(nearColour(at(75.0, 75.0), kBlue)) << "above them it stays";
     EXPECT_TRUE(nearColour(at(30.0, 0.0), kGreen));
-    EXPECT_EQ(skinOverHairBesideFace(t, mesh, fit, cv::Mat(), sides, tables), 0) << "no hair known, nothing repainted";
+    EXPECT_EQ(skinOverHairBesideFace(t, mesh, fit, ColourMatchMasks{}, sides, o, tables), 0) << "no hair known, nothing repainted";
+}
+
+// The same where the side photo shows the hair over the cheek (a texel that took the side photo): repainted ahead of the
+// ear's front, kept behind it (the hair's own place) and above the brows.
+TEST(PhotoTexture, HairOverTheCheekInTheSidePhotoIsRepaintedWithSkin) {
+    SideSquare square;
+    const auto hairAt = [](glm::dvec2 p) { return (p.x > 20.0 && p.x < 60.0) || p.x < -20.0; };  // p: (z, y)
+    const cv::Mat side = paintPhoto(square.fit, true, [&](glm::dvec2 p) { return hairAt(p) ? kBlue : kGreen; });
+    cv::Mat sideHair(400, 400, CV_8U);
+    for (int v = 0; v < 400; ++v)
+        for (int u = 0; u < 400; ++u) sideHair.at<unsigned char>(v, u) = hairAt(square.fit.side.toHead(cv::Point2d(u, v))) ? 255 : 0;
+    const TextureTables tables(square.mesh, square.options);
+    PhotoTexture t = textureFromPhotos(square.mesh, square.fit, square.front, square.all, side, square.all, square.options, tables);
+    ASSERT_TRUE(nearColour(square.at(t, 40.0, 0.0), kBlue)) << "the photo's hair, before";
+
+    FaceSides sides;
+    sides.innerX = 10.0;
+    sides.frontOfZ = 0.0;
+    sides.bottomY = -50.0;
+    sides.topY = 50.0;
+    EXPECT_GT(skinOverHairBesideFace(t, square.mesh, square.fit, ColourMatchMasks{{}, sideHair}, sides, square.options, tables), 0);
+    for (const double y : {-40.0, 0.0, 40.0}) EXPECT_TRUE(nearColour(square.at(t, 40.0, y), kGreen)) << "skin at 40, " << y;
+    EXPECT_TRUE(nearColour(square.at(t, -50.0, 0.0), kBlue)) << "behind the ear's front it stays";
+    EXPECT_TRUE(nearColour(square.at(t, 40.0, 75.0), kBlue)) << "above the brows it stays";
 }
 
 // No photo sees the back of the sphere: it is filled from the colours around it, not left black.

@@ -190,6 +190,35 @@ cv::Mat interiorOf(const cv::Mat& mask) {
 }
 
 // Whether a photo's pixel at (u, v) is skin by the not-skin mask (no mask: every pixel of the person counts).
+// Where the side photo is read for a point of the head (pixels), shifted from the profile's projection:
+// - Turned short of the profile (or past it), the side photo shows the side of the head further back (or forward)
+//   than a profile would; the outline, which the fit matched, stays. The side photo's eye measures it
+//   (HeadFit::eyeLeftMm): the photo is read shifted by that much, sideways only (a turn about the vertical moves
+//   nothing up or down), from the eye's distance off the midline outwards, and by a share growing from none on the
+//   midline towards it; up or down only round the eye (eyeReachMm, eyeFadeMm).
+// - Round the ears by what the ears' placement left between the head's ear and the photo's (in full within
+//   earReachMm of the ear's middle, fading out over earFadeMm or twice the shift if more, so that the reading cannot
+//   fold); both ears, as the photo stands in for the far side too.
+cv::Point2d sidePhotoPoint(const HeadFit& fit, const PhotoTextureOptions& options, const glm::dvec3& p) {
+    const auto smoothstep = [](double t) { return t * t * (3.0 - 2.0 * t); };
+    // The feature on p's side of the head (the photo stands in for both).
+    const auto onSideOf = [&](const glm::dvec3& m) { return (p.x < 0.0) == (m.x < 0.0) ? m : glm::dvec3(-m.x, m.y, m.z); };
+    double ear = 0.0;  // the ear's share
+    if (fit.earsPlaced) {
+        const double fade = std::max(options.earFadeMm, 2.0 * glm::length(fit.earLeftMm));
+        ear = 1.0 - smoothstep(std::clamp((glm::distance(p, onSideOf(fit.earMiddleMm)) - options.earReachMm) / fade, 0.0, 1.0));
+    }
+    glm::dvec2 shift = ear * fit.earLeftMm;
+    if (fit.sideEyeFound) {
+        const double offMidline = std::max(std::abs(fit.eyeMiddleMm.x), 1.0);
+        shift.x += (1.0 - ear) * smoothstep(std::min(std::abs(p.x) / offMidline, 1.0)) * fit.eyeLeftMm.x;
+        const double fade = std::max(options.eyeFadeMm, 2.0 * std::abs(fit.eyeLeftMm.y));
+        shift.y += (1.0 - smoothstep(std::clamp((glm::distance(p, onSideOf(fit.eyeMiddleMm)) - options.eyeReachMm) / fade, 0.0, 1.0))) *
+                   fit.eyeLeftMm.y;
+    }
+    return fit.side.toPixel(glm::dvec2(p.z, p.y) + shift);
+}
+
 bool isSkin(const cv::Mat& notSkin, float u, float v) {
     if (notSkin.empty()) return true;
     const int x = std::clamp(static_cast<int>(std::lround(u)), 0, notSkin.cols - 1);
@@ -346,43 +375,13 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     };
     const std::vector<glm::dvec3> normals = fitted.vertexNormals();
     const std::vector<glm::dvec3> smooth = smoothedNormals(fitted, normals, kDecisionRings);
-    // Where the side photo is read, shifted from the profile's projection (side view: forward, up):
-    // - Turned short of the profile (or past it), the side photo shows the side of the head further back (or
-    //   forward) than a profile would; the outline, which the fit matched, stays. The side photo's eye measures it
-    //   (HeadFit::eyeLeftMm): the photo is read shifted by that much, sideways only (a turn about the vertical moves
-    //   nothing up or down), from the eye's distance off the midline outwards, and by a share growing from none on
-    //   the midline towards it.
-    // - Round the ears by what the ears' placement left between the head's ear and the photo's (in full within
-    //   earReachMm of the ear's middle, fading out over earFadeMm or twice the shift if more, so that the reading
-    //   cannot fold); both ears, as the photo stands in for the far side too.
-    const auto smoothstep = [](double t) { return t * t * (3.0 - 2.0 * t); };
-    const double earFade = std::max(options.earFadeMm, 2.0 * glm::length(fit.earLeftMm));
-    const double eyeOffMidline = std::max(std::abs(fit.eyeMiddleMm.x), 1.0);
-    const auto sideShift = [&](const glm::dvec3& p) {
-        double ear = 0.0;  // the ear's share
-        if (fit.earsPlaced) {
-            const glm::dvec3& m = fit.earMiddleMm;
-            const glm::dvec3 near = (p.x < 0.0) == (m.x < 0.0) ? m : glm::dvec3(-m.x, m.y, m.z);
-            ear = 1.0 - smoothstep(std::clamp((glm::distance(p, near) - options.earReachMm) / earFade, 0.0, 1.0));
-        }
-        glm::dvec2 s = ear * fit.earLeftMm;
-        if (fit.sideEyeFound) {
-            s.x += (1.0 - ear) * smoothstep(std::min(std::abs(p.x) / eyeOffMidline, 1.0)) * fit.eyeLeftMm.x;
-            const glm::dvec3& m = fit.eyeMiddleMm;
-            const glm::dvec3 near = (p.x < 0.0) == (m.x < 0.0) ? m : glm::dvec3(-m.x, m.y, m.z);
-            s.y += (1.0 - smoothstep(std::clamp((glm::distance(p, near) - options.eyeReachMm) /
-                                                std::max(options.eyeFadeMm, 2.0 * std::abs(fit.eyeLeftMm.y)), 0.0, 1.0))) *
-                   fit.eyeLeftMm.y;
-        }
-        return s;
-    };
     std::vector<VertexViews> views(fitted.positions.size());
     std::array<std::vector<ViewVertex>, 3> depthVertices;  // front, from -x, from +x
     for (auto& d : depthVertices) d.resize(fitted.positions.size());
     for (std::size_t i = 0; i < fitted.positions.size(); ++i) {
         const glm::dvec3& p = fitted.positions[i];
         const cv::Point2d f = fit.front.toPixel({p.x, p.y});
-        const cv::Point2d s = fit.side.toPixel(glm::dvec2(p.z, p.y) + sideShift(p));
+        const cv::Point2d s = sidePhotoPoint(fit, options, p);
         const glm::dvec3& n = normals[i];
         const glm::dvec3& m = smooth[i];
         VertexViews& v = views[i];
@@ -632,17 +631,17 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     return out;
 }
 
-int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const cv::Mat& frontNotSkin,
-                           const FaceSides& sides, const TextureTables& tables) {
-    if (frontNotSkin.empty()) return 0;
+int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const ColourMatchMasks& notSkin,
+                           const FaceSides& sides, const PhotoTextureOptions& options, const TextureTables& tables) {
+    if (notSkin.frontNotSkin.empty() && notSkin.sideNotSkin.empty()) return 0;
     if (texture.texture.size() != tables.full().size || !tables.fits(fitted))
         throw BoothError(ErrorKind::Internal, "", "texture: the texel tables were made for another mesh or size");
     const TexelMap& map = tables.full();
     const cv::Size size = map.size;
     const auto onSides = [&](const glm::dvec3& p) {
-        return std::abs(p.x) >= sides.innerX && p.y >= sides.bottomY && p.y <= sides.topY;
+        return std::abs(p.x) >= sides.innerX && p.z >= sides.frontOfZ && p.y >= sides.bottomY && p.y <= sides.topY;
     };
-    // Each texel that took the front photo: skin (a source of the fill) or hair on the face's sides (repainted).
+    // Each texel that took a photo: skin (a source of the fill) or hair on the face's sides (repainted).
     cv::Mat colour(size, CV_32FC3, cv::Scalar::all(0)), weight(size, CV_32F, cv::Scalar(0));
     cv::Mat target(size, CV_8U, cv::Scalar(0));
     cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
@@ -651,13 +650,15 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
             const unsigned char* src = texture.source.ptr<unsigned char>(y);
             const cv::Vec3b* in = texture.texture.ptr<cv::Vec3b>(y);
             for (int x = 0; x < size.width; ++x) {
-                if (tri[x] < 0 || src[x] != PhotoTexture::Front) continue;
+                if (tri[x] < 0 || (src[x] != PhotoTexture::Front && src[x] != PhotoTexture::Side)) continue;
                 const glm::uvec3& t = fitted.triangles[static_cast<std::size_t>(tri[x])];
                 const cv::Vec2d b = map.barycentric(tri[x], x, y);
                 const glm::dvec3 p = b[0] * fitted.positions[t.x] + b[1] * fitted.positions[t.y] +
                                      (1.0 - b[0] - b[1]) * fitted.positions[t.z];
-                const cv::Point2d px = fit.front.toPixel({p.x, p.y});
-                if (isSkin(frontNotSkin, static_cast<float>(px.x), static_cast<float>(px.y))) {
+                const bool front = src[x] == PhotoTexture::Front;
+                const cv::Mat& hair = front ? notSkin.frontNotSkin : notSkin.sideNotSkin;
+                const cv::Point2d px = front ? fit.front.toPixel({p.x, p.y}) : sidePhotoPoint(fit, options, p);
+                if (isSkin(hair, static_cast<float>(px.x), static_cast<float>(px.y))) {
                     colour.at<cv::Vec3f>(y, x) = cv::Vec3f(in[x][0], in[x][1], in[x][2]);
                     weight.at<float>(y, x) = 1.0f;
                 } else if (onSides(p)) {

@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace avatarbooth {
@@ -118,21 +119,23 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
                                const cv::Mat& side, const cv::Mat& sideMask, const PhotoTextureOptions& options = {},
                                const ColourMatchMasks& notSkin = {});
 
-// Long hair or a bob hanging past the face's sides: the front photo shows it over the cheeks and temples, and the
-// avatar's hair part, which leaves the face clear, does not, so that the photo's hair lay painted on bare cheeks
-// (FRMDB 006, 007, 008). The part of the head where that happens, in millimetres: outward of innerX on either side
-// (the eyes' outer corners: the brows, lashes and eyes, which count as hair too, lie inside), between bottomY and
-// topY (the brows' top; the chin, or the nose tip when a beard is grown).
+// Long hair or a bob hanging past the face's sides: the photos show it over the cheeks and temples, and the avatar's
+// hair part, which leaves the face clear, does not, so that the photos' hair lay painted on bare cheeks (FRMDB 006,
+// 007, 008). The part of the head where that happens, in millimetres: outward of innerX on either side (the eyes'
+// outer corners: the brows, lashes and eyes, which count as hair too, lie inside), ahead of frontOfZ (the ears' front:
+// hair behind the ears is the hair's), between bottomY and topY (the brows' top; the chin, or the nose tip when a
+// beard is grown).
 struct FaceSides {
     double innerX = 0.0;
+    double frontOfZ = -std::numeric_limits<double>::infinity();
     double bottomY = 0.0, topY = 0.0;
 };
-// Repaints the texels of `sides` that took the front photo where it shows hair (frontNotSkin: non-zero off the
-// skin, as ColourMatchMasks) with the face's skin round them: continued by pull-push from the texels that took the
-// front photo's skin, with the skin layer's fine detail (tables.skinDetail), feathered at the edge. Returns how many
-// texels were repainted.
-int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const cv::Mat& frontNotSkin,
-                           const FaceSides& sides, const TextureTables& tables);
+// Repaints the texels of `sides` that took a photo where it shows hair (notSkin: each photo's pixels off the skin; an
+// empty mask says none) with the skin round them: continued by pull-push from the texels that took either photo's
+// skin, with the skin layer's fine detail (tables.skinDetail), feathered at the edge. `options`: those the texture
+// was made with (where it read the side photo). Returns how many texels were repainted.
+int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const ColourMatchMasks& notSkin,
+                           const FaceSides& sides, const PhotoTextureOptions& options, const TextureTables& tables);
 
 // Where no photo saw the head (texels the fill made up: under the chin, in and behind the ears, parts of the top),
 // the base head's skin layer lends its detail (TextureTables::skinDetail, added by textureFromPhotos), so that ears,
