@@ -84,15 +84,21 @@ std::optional<std::pair<cv::Point2d, double>> templatePeak(const SideCrop& c, co
                     places.emplace_back(v, cv::Point(x, y));
             }
         std::sort(places.begin(), places.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-        std::vector<cv::Point> window;
-        cv::findNonZero(tmask, window);
+        // How many of the window's pixels lie on hair and on the person, at every place at once (counted pixel by
+        // pixel for each place in turn, the search took 450 ms where hair covers the ear: FRMDB 007).
+        const auto countsUnder = [&](const cv::Mat& pixels) {
+            const cv::Mat onPixels = pixels != 0, inWindow = tmask != 0;
+            cv::Mat on, window, counts;
+            onPixels.convertTo(on, CV_32F, 1.0 / 255.0);
+            inWindow.convertTo(window, CV_32F, 1.0 / 255.0);
+            cv::matchTemplate(on, window, counts, cv::TM_CCORR);
+            return counts;
+        };
+        const cv::Mat hairCount = countsUnder(c.hair), personCount = countsUnder(c.mask);
+        const int windowSize = cv::countNonZero(tmask);
         for (const auto& [v, p] : places) {
-            int onHair = 0, onPerson = 0;
-            for (const cv::Point& q : window) {
-                onHair += c.hair.at<unsigned char>(p + q) != 0;
-                onPerson += c.mask.at<unsigned char>(p + q) != 0;
-            }
-            if (2 * onHair > static_cast<int>(window.size()) || onPerson < 0.95 * static_cast<double>(window.size())) continue;
+            const int onHair = cvRound(hairCount.at<float>(p)), onPerson = cvRound(personCount.at<float>(p));
+            if (2 * onHair > windowSize || onPerson < 0.95 * static_cast<double>(windowSize)) continue;
             best = v;
             at = {c.origin.x + p.x + ear.centre.x * f, c.origin.y + p.y + ear.centre.y * f};
             *scaleOut = s;
