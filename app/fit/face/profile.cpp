@@ -735,13 +735,7 @@ ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, con
     const cv::Point2d nasion = pt("nasion"), tip = pt("nose_tip"), top = pt("top_of_head");
     const double V = tip.y - top.y;
     if (V < 20.0) return turn;
-    // The face's front edge on a row: the last mask pixel at or before the nose tip's column.
-    const std::function<int(int)> frontEdge = [&](int y) {
-        const auto* m = mask.ptr<unsigned char>(y);
-        for (int x = std::min(mask.cols - 1, cvRound(tip.x) + 2); x >= 0; --x)
-            if (m[x]) return x;
-        return -1;
-    };
+    const std::function<int(int)> frontEdge = [&](int y) { return faceFrontEdge(mask, tip.x, y); };
     // The eye: the darkest pixels (5%) in a band from just above the nasion to 0.15 V below it, up to 0.3 V behind
     // the outline; their mean distance behind it.
     {
@@ -772,6 +766,13 @@ ProfileTurn estimateProfileTurn(const cv::Mat& bgrIn, const cv::Mat& maskIn, con
                               (pt("glabella").x - pt("back_of_head").x) / V);
     turn.pastProfile = turnedPastProfile(turn.degrees, turn.ear);
     return turn;
+}
+
+int faceFrontEdge(const cv::Mat& mask, double tipX, int y) {
+    const auto* m = mask.ptr<unsigned char>(y);
+    for (int x = std::min(mask.cols - 1, cvRound(tipX) + 2); x >= 0; --x)
+        if (m[x]) return x;
+    return -1;
 }
 
 std::optional<cv::Rect> faceOnPerson(const LandmarkDetector& detector, const cv::Mat& bgr, const cv::Mat& personMask) {

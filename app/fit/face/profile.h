@@ -171,6 +171,10 @@ struct SideOptions {
     bool refuseShortOfProfile = true;
 };
 
+// The face's front edge on row y of a side photo facing image-right (mask: CV_8U, non-zero on the person): the last
+// person pixel at or before the nose tip's column (tipX, and 2 pixels for the tip's rounding); -1 where there is none.
+int faceFrontEdge(const cv::Mat& mask, double tipX, int y);
+
 // A face's turn from the front by its 68 points: the nose tip's offset from the middle of the eyes' outer corners,
 // along the eye line, in eye widths (positive: the nose towards image-right). The front guide's measure.
 double noseOffsetYaw(const std::array<cv::Point2d, 68>& points);

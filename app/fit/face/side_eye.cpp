@@ -42,21 +42,15 @@ SideEyeSpot locateSideEye(const cv::Mat& bgrIn, const cv::Mat& maskIn, const cv:
                                      cvRound((options.furthest + 0.1) * V) + 2 * margin, y1 - y0 + 1 + 2 * margin) &
                             cv::Rect(0, 0, bgr.cols, bgr.rows);
     if (region.width < 8 || region.height < 8) return spot;
-    const cv::Mat m = mask(region);
-    // The band: on each row, from `nearest` to `furthest` behind the face's front edge (the last person pixel at or
-    // before the nose tip's column), on the person and off the large hair regions.
+    // The band: on each row, from `nearest` to `furthest` behind the face's front edge, on the person and off the
+    // large hair regions.
     cv::Mat band(region.size(), CV_8U, cv::Scalar(0));
     for (int y = std::max(y0, region.y); y <= std::min(y1, region.y + region.height - 1); ++y) {
-        const auto* row = m.ptr<unsigned char>(y - region.y);
-        int edge = -1;
-        for (int x = std::min(region.width - 1, cvRound(tip.x) + 2 - region.x); x >= 0; --x)
-            if (row[x]) {
-                edge = x;
-                break;
-            }
+        const int edge = faceFrontEdge(mask, tip.x, y);
         if (edge < 0) continue;
-        for (int x = std::max(0, cvRound(edge - options.furthest * V)); x <= edge - cvRound(options.nearest * V); ++x)
-            if (row[x]) band.at<unsigned char>(y - region.y, x) = 255;
+        const auto* row = mask.ptr<unsigned char>(y);
+        for (int x = std::max(region.x, cvRound(edge - options.furthest * V)); x <= edge - cvRound(options.nearest * V); ++x)
+            if (row[x]) band.at<unsigned char>(y - region.y, x - region.x) = 255;
     }
     if (hairKnown) {
         // Hair regions larger than a brow (about 0.2 V by 0.03 V) are hair, not the eye's surroundings.

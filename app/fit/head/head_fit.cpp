@@ -543,8 +543,7 @@ HeadFit fitHead(const BaseHead& base, const PhotoMeasurements& photos, const Hea
         fit.earLeftMm = fit.side.toHead(*photos.sideEar) - glm::dvec2(fit.earMiddleMm.z, fit.earMiddleMm.y);
     }
     if (photos.sideEye) {
-        glm::dvec3 eye(0.0);
-        for (int k = 36; k <= 41; ++k) eye += fit.mesh.positions[base.frontFeatures.at(landmarkName(k))] / 6.0;
+        const glm::dvec3 eye = meanVertex(fit.mesh, base, 36, 41);
         const glm::dvec2 left = fit.side.toHead(*photos.sideEye) - glm::dvec2(eye.z, eye.y);
         // The photos share the eye's height (the side photo's rows are tied to the front's): a dark spot found
         // further above or below is a shadow or hair, not the eye.
