@@ -216,6 +216,55 @@ TEST(HairPart, NothingAheadOfTheJawsTopIsTucked) {
 
 namespace {
 
+// A flat sheet at x = `x` over z0..z1, y0..y1, a vertex every `step` mm, triangulated (facing either way: the tuck
+// looks at it from the side it is on).
+void addSheet(Mesh& m, double x, double z0, double z1, double y0, double y1, double step) {
+    const auto first = static_cast<std::uint32_t>(m.positions.size());
+    const int cols = static_cast<int>(std::lround((z1 - z0) / step)) + 1, rows = static_cast<int>(std::lround((y1 - y0) / step)) + 1;
+    for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c) m.positions.emplace_back(x, y0 + r * step, z0 + c * step);
+    for (int r = 0; r + 1 < rows; ++r)
+        for (int c = 0; c + 1 < cols; ++c) {
+            const auto a = first + static_cast<std::uint32_t>(r * cols + c);
+            const auto cols32 = static_cast<std::uint32_t>(cols);
+            m.triangles.emplace_back(a, a + 1, a + cols32 + 1);
+            m.triangles.emplace_back(a, a + cols32 + 1, a + cols32);
+        }
+}
+
+}  // namespace
+
+TEST(HairPart, HairUnderTheSkinDoesNotCountAndTheHeadsSideKeepsItsShape) {
+    // The head's left side a wall at x 75 round the ears' window, with an ear standing out 11 mm from it (z -10..10,
+    // y -10..20); bob02 on the fitted head of FRMDB 008 had a layer 20-30 mm under the skin beside the ear, and the
+    // head pressed in under it showed as a dent down the cheek.
+    Mesh head;
+    addSheet(head, 75.0, -70.0, 40.0, -70.0, 70.0, 5.0);
+    const auto earFirst = head.positions.size();
+    addSheet(head, 86.0, -10.0, 10.0, -10.0, 20.0, 5.0);
+    const auto earEnd = head.positions.size();
+    // Hair: a layer deep under the skin (x 50) and the visible one outside it (x 84).
+    Mesh hair;
+    addSheet(hair, 50.0, -40.0, 40.0, -45.0, 50.0, 10.0);
+    addSheet(hair, 84.0, -40.0, 40.0, -45.0, 50.0, 10.0);
+    const Mesh before = head;
+    EXPECT_EQ(tuckEarsUnderHair(head, hair, 30.0), static_cast<int>(earEnd - earFirst));
+    for (std::size_t k = 0; k < head.positions.size(); ++k) {
+        if (k >= earFirst && k < earEnd) EXPECT_DOUBLE_EQ(head.positions[k].x, 84.0 - 1.5) << "the ear goes under the visible hair";
+        else EXPECT_EQ(head.positions[k], before.positions[k]) << "the head's side stays, vertex " << k;
+    }
+    // Hair lying 1 mm under the head's side (within EarTuck::hiddenDepth) counts: the ear goes down to the side, no
+    // further, and the side stays.
+    Mesh close;
+    addSheet(close, 74.0, -40.0, 40.0, -45.0, 50.0, 10.0);
+    head = before;
+    tuckEarsUnderHair(head, close, 30.0);
+    for (std::size_t k = 0; k < head.positions.size(); ++k)
+        EXPECT_DOUBLE_EQ(head.positions[k].x, 75.0) << "vertex " << k;
+}
+
+namespace {
+
 // A front photo at 0.5 mm a pixel with its middle brow points 19 and 24 at row 200, columns 100 and 140.
 std::array<cv::Point2d, 68> browsAtRow200() {
     std::array<cv::Point2d, 68> points{};

@@ -445,7 +445,7 @@ TEST(PhotoTexture, SidePhotosEyeLandsOnTheHeadsEye) {
 
 // Hair the front photo shows over the face's sides (blue, marked not-skin) is repainted with the skin round it (green)
 // where the sides are (outward of 40 mm, between 50 mm down and up); inside them (the brows and eyes, which count as
-// hair too) and above them (the hairline) it stays.
+// hair too) and above them (the hairline) it stays, after a fade.
 TEST(PhotoTexture, HairBesideTheFaceIsRepaintedWithSkin) {
     Mesh mesh;
     constexpr double half = 90.0;
@@ -477,7 +477,12 @@ TEST(PhotoTexture, HairBesideTheFaceIsRepaintedWithSkin) {
     for (const double x : {-80.0, -70.0, 70.0, 80.0})
         for (const double y : {-40.0, 0.0, 40.0}) EXPECT_TRUE(nearColour(at(x, y), kGreen)) << "skin at " << x << ", " << y;
     EXPECT_TRUE(nearColour(at(0.0, 0.0), kBlue)) << "inside the sides it stays";
-    EXPECT_TRUE(nearColour(at(75.0, 75.0), kBlue)) << "above them it stays";
+    EXPECT_TRUE(nearColour(at(75.0, 75.0), kBlue)) << "above them, past FaceSides::fadeMm, it stays";
+    // In between the repaint fades out: cut at the brows' top, the photo's hair ended in a straight edge across the
+    // temples (FRMDB 008). Half-way up the fade, about half of each (green's blue channel 40, blue's 200).
+    const cv::Vec3i mid = at(75.0, 50.0 + 0.5 * sides.fadeMm);
+    EXPECT_GT(mid[0], 40 + 40) << "some of the photo's hair is left: " << mid;
+    EXPECT_LT(mid[0], 200 - 40) << "some skin is painted over it: " << mid;
     EXPECT_TRUE(nearColour(at(30.0, 0.0), kGreen));
     EXPECT_EQ(skinOverHairBesideFace(t, mesh, fit, ColourMatchMasks{}, sides, o, tables), 0) << "no hair known, nothing repainted";
 }

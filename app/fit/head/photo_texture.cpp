@@ -638,12 +638,20 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
         throw BoothError(ErrorKind::Internal, "", "texture: the texel tables were made for another mesh or size");
     const TexelMap& map = tables.full();
     const cv::Size size = map.size;
-    const auto onSides = [&](const glm::dvec3& p) {
-        return std::abs(p.x) >= sides.innerX && p.z >= sides.frontOfZ && p.y >= sides.bottomY && p.y <= sides.topY;
+    // How much a point is on the face's sides: 1 inside, fading out above, behind and under them.
+    const auto fadeOut = [&](double beyond) {
+        if (beyond <= 0.0) return 1.0;
+        if (sides.fadeMm <= 0.0 || beyond >= sides.fadeMm) return 0.0;
+        const double t = beyond / sides.fadeMm;
+        return 1.0 - t * t * (3.0 - 2.0 * t);
     };
-    // Each texel that took a photo: skin (a source of the fill) or hair on the face's sides (repainted).
+    const auto onSides = [&](const glm::dvec3& p) {
+        if (std::abs(p.x) < sides.innerX) return 0.0;
+        return fadeOut(p.y - sides.topY) * fadeOut(sides.bottomY - p.y) * fadeOut(sides.frontOfZ - p.z);
+    };
+    // Each texel that took a photo: skin (a source of the fill) or hair on the face's sides (repainted, by how much).
     cv::Mat colour(size, CV_32FC3, cv::Scalar::all(0)), weight(size, CV_32F, cv::Scalar(0));
-    cv::Mat target(size, CV_8U, cv::Scalar(0));
+    cv::Mat target(size, CV_32F, cv::Scalar(0));
     cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
         for (int y = rows.start; y < rows.end; ++y) {
             const int* tri = map.triangle.ptr<int>(y);
@@ -661,14 +669,14 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
                 if (isSkin(hair, static_cast<float>(px.x), static_cast<float>(px.y))) {
                     colour.at<cv::Vec3f>(y, x) = cv::Vec3f(in[x][0], in[x][1], in[x][2]);
                     weight.at<float>(y, x) = 1.0f;
-                } else if (onSides(p)) {
-                    target.at<unsigned char>(y, x) = 255;
+                } else {
+                    target.at<float>(y, x) = static_cast<float>(onSides(p));
                 }
             }
         }
     });
-    const int repainted = cv::countNonZero(target);
-    if (repainted == 0 || cv::countNonZero(weight) == 0) return 0;
+    const int repainted = cv::countNonZero(target >= 0.5f);
+    if (cv::countNonZero(target > 0.0f) == 0 || cv::countNonZero(weight) == 0) return 0;
     // The fill at a quarter of the resolution (the skin's colour varies slowly; its detail is added at full
     // resolution), and the edge feathered over a few texels there, so that no hard edge is left where the photo's
     // hair ended.
@@ -681,7 +689,6 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
             if (const float w = smallWeight.at<float>(y, x); w > 0.0f) smallColour.at<cv::Vec3f>(y, x) /= w;
     pullPushFill(smallColour, smallWeight);
     cv::resize(target, smallTarget, small, 0, 0, cv::INTER_AREA);
-    smallTarget.convertTo(smallTarget, CV_32F, 1.0 / 255.0);
     cv::GaussianBlur(smallTarget, smallTarget, cv::Size(), 1.0);
     // Both read at full resolution, bilinearly, and only where the feathered edge reaches.
     const auto mix = [&](const cv::Mat& m, auto zero, int x, int y) {
@@ -697,11 +704,11 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
     const cv::Mat& detail = tables.skinDetail();
     for (int y = 0; y < size.height; ++y) {
         const int* tri = map.triangle.ptr<int>(y);
-        const unsigned char* t = target.ptr<unsigned char>(y);
+        const float* t = target.ptr<float>(y);
         cv::Vec3b* o = texture.texture.ptr<cv::Vec3b>(y);
         for (int x = 0; x < size.width; ++x) {
             if (tri[x] < 0) continue;
-            const float wx = t[x] ? 1.0f : mix(smallTarget, 0.0f, x, y);
+            const float wx = std::max(t[x], mix(smallTarget, 0.0f, x, y));
             if (wx <= 0.0f) continue;
             cv::Vec3f skin = mix(smallColour, cv::Vec3f(), x, y);
             if (!detail.empty()) {

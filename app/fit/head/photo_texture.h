@@ -124,11 +124,13 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
 // 007, 008). The part of the head where that happens, in millimetres: outward of innerX on either side (the eyes'
 // outer corners: the brows, lashes and eyes, which count as hair too, lie inside), ahead of frontOfZ (the ears' front:
 // hair behind the ears is the hair's), between bottomY and topY (the brows' top; the chin, or the nose tip when a
-// beard is grown).
+// beard is grown). Above topY, behind frontOfZ and under bottomY the repaint fades out over fadeMm (smoothly): cut
+// there, the photo's hair at the temples ended in a straight edge across them (FRMDB 008).
 struct FaceSides {
     double innerX = 0.0;
     double frontOfZ = -std::numeric_limits<double>::infinity();
     double bottomY = 0.0, topY = 0.0;
+    double fadeMm = 15.0;
 };
 // Repaints the texels of `sides` that took a photo where it shows hair (notSkin: each photo's pixels off the skin; an
 // empty mask says none) with the skin round them: continued by pull-push from the texels that took either photo's

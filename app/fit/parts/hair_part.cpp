@@ -236,45 +236,100 @@ double foreheadShownMm(const cv::Mat& hair, const std::array<cv::Point2d, 68>& p
     return std::max(0.0, shown[shown.size() / 2] - margin);
 }
 
+namespace {
+
+// The side-on maps tuckEarsUnderHair works on: per side (+x, -x), a value per cell of `cell` mm over a window in
+// z (columns, from behind to ahead) and y (rows, from below).
+struct SideMaps {
+    double z0, y0, cell;
+    int cols, rows;
+    std::array<cv::Mat, 2> map;  // CV_64F
+
+    SideMaps(double z0_, double z1, double y0_, double y1, double cell_, double fill)
+        : z0(z0_), y0(y0_), cell(cell_), cols(static_cast<int>(std::ceil((z1 - z0_) / cell_))),
+          rows(static_cast<int>(std::ceil((y1 - y0_) / cell_))) {
+        for (cv::Mat& m : map) m = cv::Mat(rows, cols, CV_64F, cv::Scalar(fill));
+    }
+    // Each cell's centre a triangle covers seen from the side, with the triangle's |x| there (triangles across the
+    // middle are over the crown, the face or the nape, not beside an ear).
+    template <class Visit>
+    void rasterise(const Mesh& mesh, Visit visit) {
+        for (const glm::uvec3& t : mesh.triangles) {
+            const glm::dvec3& a = mesh.positions[t[0]];
+            const glm::dvec3& b = mesh.positions[t[1]];
+            const glm::dvec3& c = mesh.positions[t[2]];
+            if ((a.x > 0.0) != (b.x > 0.0) || (a.x > 0.0) != (c.x > 0.0)) continue;
+            const int side = a.x > 0.0 ? 0 : 1;
+            const double det = (b.z - a.z) * (c.y - a.y) - (c.z - a.z) * (b.y - a.y);
+            if (std::abs(det) < 1e-12) continue;  // edge-on from the side: its neighbours cover it
+            const int c0 = std::max(0, static_cast<int>(std::floor((std::min({a.z, b.z, c.z}) - z0) / cell)));
+            const int c1 = std::min(cols - 1, static_cast<int>(std::floor((std::max({a.z, b.z, c.z}) - z0) / cell)));
+            const int r0 = std::max(0, static_cast<int>(std::floor((std::min({a.y, b.y, c.y}) - y0) / cell)));
+            const int r1 = std::min(rows - 1, static_cast<int>(std::floor((std::max({a.y, b.y, c.y}) - y0) / cell)));
+            for (int r = r0; r <= r1; ++r)
+                for (int col = c0; col <= c1; ++col) {
+                    const double z = z0 + (col + 0.5) * cell, y = y0 + (r + 0.5) * cell;
+                    const double u = ((z - a.z) * (c.y - a.y) - (c.z - a.z) * (y - a.y)) / det;
+                    const double v = ((b.z - a.z) * (y - a.y) - (z - a.z) * (b.y - a.y)) / det;
+                    if (u < 0.0 || v < 0.0 || u + v > 1.0) continue;
+                    visit(side, r, col, std::abs(a.x + u * (b.x - a.x) + v * (c.x - a.x)));
+                }
+        }
+    }
+    // The cell holding (z, y), or nothing outside the window.
+    std::optional<std::pair<int, int>> cellOf(double z, double y) const {
+        const int col = static_cast<int>(std::floor((z - z0) / cell)), r = static_cast<int>(std::floor((y - y0) / cell));
+        if (col < 0 || col >= cols || r < 0 || r >= rows) return std::nullopt;
+        return std::pair{r, col};
+    }
+};
+
+}  // namespace
+
 int tuckEarsUnderHair(Mesh& head, const Mesh& hair, double jawZ, const EarTuck& tuck) {
-    // The window, in cells of the side-on map: columns along z (from behind to ahead), rows along y.
     const double z0 = -tuck.behind, z1 = std::min(tuck.ahead, jawZ), y0 = -tuck.below, y1 = tuck.above;
     if (z1 <= z0 || tuck.cell <= 0.0) return 0;
-    const int cols = static_cast<int>(std::ceil((z1 - z0) / tuck.cell)), rows = static_cast<int>(std::ceil((y1 - y0) / tuck.cell));
     const double inf = std::numeric_limits<double>::infinity();
-    // The hair's innermost |x| over each cell, one map per side (+x, -x).
-    std::array<std::vector<double>, 2> inner{std::vector<double>(static_cast<std::size_t>(rows * cols), inf),
-                                             std::vector<double>(static_cast<std::size_t>(rows * cols), inf)};
-    for (const glm::uvec3& t : hair.triangles) {
-        const glm::dvec3& a = hair.positions[t[0]];
-        const glm::dvec3& b = hair.positions[t[1]];
-        const glm::dvec3& c = hair.positions[t[2]];
-        // A triangle across the middle is over the crown or the nape, not beside an ear.
-        if ((a.x > 0.0) != (b.x > 0.0) || (a.x > 0.0) != (c.x > 0.0)) continue;
-        auto& map = inner[a.x > 0.0 ? 0 : 1];
-        const double det = (b.z - a.z) * (c.y - a.y) - (c.z - a.z) * (b.y - a.y);
-        if (std::abs(det) < 1e-12) continue;  // edge-on from the side: its neighbours cover it
-        const int c0 = std::max(0, static_cast<int>(std::floor((std::min({a.z, b.z, c.z}) - z0) / tuck.cell)));
-        const int c1 = std::min(cols - 1, static_cast<int>(std::floor((std::max({a.z, b.z, c.z}) - z0) / tuck.cell)));
-        const int r0 = std::max(0, static_cast<int>(std::floor((std::min({a.y, b.y, c.y}) - y0) / tuck.cell)));
-        const int r1 = std::min(rows - 1, static_cast<int>(std::floor((std::max({a.y, b.y, c.y}) - y0) / tuck.cell)));
-        for (int r = r0; r <= r1; ++r)
-            for (int col = c0; col <= c1; ++col) {
-                const double z = z0 + (col + 0.5) * tuck.cell, y = y0 + (r + 0.5) * tuck.cell;
-                const double u = ((z - a.z) * (c.y - a.y) - (c.z - a.z) * (y - a.y)) / det;
-                const double v = ((b.z - a.z) * (y - a.y) - (z - a.z) * (b.y - a.y)) / det;
-                if (u < 0.0 || v < 0.0 || u + v > 1.0) continue;
-                double& m = map[static_cast<std::size_t>(r * cols + col)];
-                m = std::min(m, std::abs(a.x + u * (b.x - a.x) + v * (c.x - a.x)));
-            }
+    // The side of the head without its ears: the head's outermost |x| over each cell, opened (a minimum, then a
+    // maximum over a disc wider than an ear), on a map reaching past the window so that the disc finds the head
+    // round the ear everywhere in it.
+    const double reach = tuck.skullOpening;
+    SideMaps skull(z0 - reach, z1 + reach, y0 - reach, y1 + reach, tuck.cell, 0.0);
+    skull.rasterise(head, [&](int side, int r, int col, double x) {
+        double& m = skull.map[static_cast<std::size_t>(side)].at<double>(r, col);
+        m = std::max(m, x);
+    });
+    const int radius = static_cast<int>(std::lround(reach / tuck.cell));
+    const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
+    for (cv::Mat& m : skull.map) {
+        m.setTo(inf, m == 0.0);  // no head seen there: leave it out of the minimum
+        cv::morphologyEx(m, m, cv::MORPH_OPEN, disc);
+        m.setTo(0.0, m == inf);
     }
+    // The hair's innermost |x| over each cell, of the hair that lies outside the skull or nearly: MakeHuman's bob02
+    // has layers deep inside the fitted head beside the ears (20-30 mm under the skin on FRMDB 008), which no one
+    // sees, and the head pressed in under them showed as a dent down the cheek.
+    SideMaps inner(z0, z1, y0, y1, tuck.cell, inf);
+    inner.rasterise(hair, [&](int side, int r, int col, double x) {
+        const double z = z0 + (col + 0.5) * tuck.cell, y = y0 + (r + 0.5) * tuck.cell;
+        const auto s = skull.cellOf(z, y);
+        if (s && x < skull.map[static_cast<std::size_t>(side)].at<double>(s->first, s->second) - tuck.hiddenDepth) return;
+        double& m = inner.map[static_cast<std::size_t>(side)].at<double>(r, col);
+        m = std::min(m, x);
+    });
     int moved = 0;
     for (glm::dvec3& p : head.positions) {
         if (p.z < z0 || p.z >= z1 || p.y < y0 || p.y >= y1) continue;
-        const int col = static_cast<int>((p.z - z0) / tuck.cell), r = static_cast<int>((p.y - y0) / tuck.cell);
-        const double limit = inner[p.x > 0.0 ? 0 : 1][static_cast<std::size_t>(r * cols + col)] - tuck.clearance;
+        const auto c = inner.cellOf(p.z, p.y);
+        const auto s = skull.cellOf(p.z, p.y);
+        if (!c || !s) continue;
+        const std::size_t side = p.x > 0.0 ? 0 : 1;
+        const double limit = inner.map[side].at<double>(c->first, c->second) - tuck.clearance;
         if (std::abs(p.x) <= limit || limit <= 0.0) continue;  // under the hair already, or no hair over it
-        p.x = std::copysign(limit, p.x);
+        // Only what stands out of the head's side (the ear) goes under the hair; the side itself stays.
+        const double to = std::max(limit, std::min(std::abs(p.x), skull.map[side].at<double>(s->first, s->second)));
+        if (to >= std::abs(p.x)) continue;
+        p.x = std::copysign(to, p.x);
         ++moved;
     }
     return moved;

@@ -62,12 +62,17 @@ struct EarTuck {
     double cell = 1.0;                   // the side-on map of the hair's innermost layer: its cell
     double above = 45.0, below = 40.0;   // the ears' window: over and under the ear holes' centre
     double ahead = 30.0, behind = 35.0;  // ... and before and behind it (never ahead of the jaw's top, `jawZ`)
+    // The side of the head without its ears is the head's side-on outline opened by a disc of this radius (an ear
+    // is about 30 mm long); hair more than `hiddenDepth` under it lies under the skin, unseen, and does not count.
+    double skullOpening = 20.0;
+    double hiddenDepth = 3.0;
 };
 
 // MakeHuman's hair styles cover the ears of its default head; a fitted head's ears stand out through long hair and
 // showed as an arc drawn on the hair from the side (FRMDB 005, 006, 007). Seen from either side, each head vertex in
-// the ears' window that lies outside the hair's innermost layer there is moved in, towards the middle, to
-// `clearance` inside it: an ear under hair stays under it; where no hair lies over it, the ear shows as it is.
+// the ears' window that lies outside the hair's innermost layer there (of the hair that is not under the skin) is
+// moved in, towards the middle, to `clearance` inside it, but not under the side of the head round the ear: an ear
+// under hair stays under it, the head's side keeps its shape; where no hair lies over it, the ear shows as it is.
 // `jawZ`: the depth of the jaw's top (ibug 0 and 16) on the fitted head, before which nothing moves (the face is
 // keepFaceClear's). Returns how many vertices moved.
 int tuckEarsUnderHair(Mesh& head, const Mesh& hair, double jawZ, const EarTuck& tuck = {});
