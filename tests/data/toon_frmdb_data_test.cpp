@@ -57,8 +57,10 @@ TEST(ToonFrmdb, RealPairGivesFacePartSizedRegionsWithTheSkinLargest) {
     EXPECT_GE(front.count, 4u);
     EXPECT_LE(front.count, 30u);  // measured 25 here, 10-28 over the 16 FRMDB pairs
     EXPECT_GE(side.count, 3u);
-    EXPECT_LE(side.count, 24u);  // measured 17 here, 7-24 over the 16 pairs
-    EXPECT_LE(front.under1Percent, 12u);  // measured 7
+    // Measured 17 and 7 here once; 24 and 12 by 2026-12-06, and 25 and 13 after the silhouette's top strip stopped
+    // learning a tall visitor's warm colours as the backdrop's (single pixels at the hair's edge moved).
+    EXPECT_LE(side.count, 27u);
+    EXPECT_LE(front.under1Percent, 15u);
     // The largest region is the face's skin: a good part of the head, centred left-right, below the hair, skin-hued.
     const toon::Region& skin = model.regionsA.regions[front.largest];
     const cv::Rect head = model.regionsA.regions.back().bbox;  // the silhouette backdrop, added last
