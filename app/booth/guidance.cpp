@@ -145,7 +145,7 @@ SideObservation PreviewAnalyser::observeSide(const cv::Mat& bgr, const cv::Mat& 
         obs.faceShows = faceOnPerson(*detector_, bgr, frameMask).has_value();
         return obs;
     }
-    obs.noseImageRight = right.ok && (!left.ok || right.noseProminence >= left.noseProminence);
+    obs.noseImageRight = profileFacesRight(right, left);
     const ProfileFit& fit = obs.noseImageRight ? right : left;  // one with a nose: `profile`
     obs.noseProminence = fit.noseProminence;
     obs.profileSeen = true;

@@ -178,6 +178,24 @@ TEST(ProfileLandmarks, AFringeAsFarForwardAsTheNoseIsNotTakenForIt) {
     EXPECT_NE(fit.warnings.back().find("taken for hair"), std::string::npos) << fit.warnings.back();
 }
 
+TEST(ProfileLandmarks, AProfileFoundAtTheCollarLosesToOneFoundWithout) {
+    // FRMDB 008's curls behind his head, without his jumper in the outline, passed as a profile facing back with a
+    // more prominent "nose" than his face's.
+    avatarbooth::ProfileFit face, curls;
+    face.ok = curls.ok = true;
+    face.noseProminence = 0.12;
+    curls.noseProminence = 0.16;
+    curls.throatAtCollar = true;
+    EXPECT_TRUE(avatarbooth::profileFacesRight(face, curls));
+    EXPECT_FALSE(avatarbooth::profileFacesRight(curls, face));
+    // Otherwise the more prominent nose, and the only one found.
+    curls.throatAtCollar = false;
+    EXPECT_FALSE(avatarbooth::profileFacesRight(face, curls));
+    face.throatAtCollar = true;
+    curls.ok = false;
+    EXPECT_TRUE(avatarbooth::profileFacesRight(face, curls));
+}
+
 TEST(ProfileLandmarks, FrontViewSilhouetteHasNoProfile) {
     // A front view: an egg-shaped head (symmetric about x = 300) on a neck and shoulders; y = 600 is the image's
     // bottom edge. The head arc runs from its lower left (where it meets the neck, y = 330) over the top to its

@@ -301,6 +301,20 @@ cv::Point2d estimateEarHole(const cv::Point2d& nasion, const cv::Point2d& chin, 
 
 namespace {
 
+// Where the front chain reaches the collar when the clothes are not in the outline, below `from` and no further than
+// `to`: the chain's end when it stops short of `to` (the outline's lowest level is the neck's cut), else the first
+// point at least `minY` down from which the chain runs back along the collar (0.25 V back while dropping less than
+// 0.05 V: long hair hangs lower at the back). -1 when neither.
+int collarIndex(const Chain& f, int from, int to, double minY, double V) {
+    if (to == f.size() - 1 && f.y(to) >= minY) return to;
+    for (int i = from + 1; i < f.size(); ++i) {
+        if (f.y(i) < minY) continue;
+        for (int j = i + 1; j < f.size() && f.y(j) - f.y(i) <= 0.05 * V; ++j)
+            if (f.xv(i) - f.xv(j) >= 0.25 * V) return i;
+    }
+    return -1;
+}
+
 // The landmarks of a profile whose nose tip is `nose` (the rest of fitProfile), or why that is no profile.
 ProfileFit fitFromNoseTip(const Chain& f, const Chain& b, const NoseChoice& nose, double yTop) {
     const int iNose = nose.index;
@@ -324,6 +338,12 @@ ProfileFit fitFromNoseTip(const Chain& f, const Chain& b, const NoseChoice& nose
     const int iMouth = walkToLevel(f, iNose, +1, f.y(iNose) + 0.25 * V);
     const int iNeckLow = walkToLevel(f, iMouth, +1, f.y(iNose) + 1.1 * V);
     int iThroat = deepestUnderChord(f, iMouth, iNeckLow);
+    // Without a plate, clothes as cold as the backdrop are left out of the silhouette (segmentPerson): the outline's
+    // front ends at the collar, or runs back along it to long hair's ends, and a straight neck shows no throat under
+    // that chord (synthetic visitors in blue and teal shirts; the next bulge down, the lips, was then taken for the
+    // nose). The chin is then sought down to the collar.
+    const int iCollar = iThroat <= iMouth + 1 ? collarIndex(f, iMouth, iNeckLow, f.y(iNose) + 0.5 * V, V) : -1;
+    if (iCollar > iMouth + 2) iThroat = iCollar;
     if (iThroat <= iMouth + 1) return fail("no chin and throat below the nose");
     // Chin. First the most forward point along a direction kChinTilt below the horizontal: where the chin's
     // outline turns from running down to running back. It finds the chin whether or not it bulges (a receding
@@ -359,7 +379,19 @@ ProfileFit fitFromNoseTip(const Chain& f, const Chain& b, const NoseChoice& nose
         }
     }
     // The throat again, from the chin: the deepest point under the chord from the chin to the neck 0.45 V below it.
-    iThroat = deepestUnderChord(f, iChin, walkToLevel(f, iChin, +1, f.y(iChin) + 0.45 * V));
+    // At the collar (above), a straight neck may show none under that chord either: the collar is the throat.
+    const int iLow = walkToLevel(f, iChin, +1, f.y(iChin) + 0.45 * V);
+    iThroat = deepestUnderChord(f, iChin, iCollar < 0 ? iLow : std::min(iCollar, iLow));
+    bool atCollar = iCollar >= 0;
+    if (f.xv(iChin) - f.xv(iThroat) < 0.1 * V) {
+        const int collar = iCollar >= 0 ? iCollar : collarIndex(f, iChin, iNeckLow, f.y(iNose) + 0.5 * V, V);
+        if (collar > iChin && f.xv(iChin) - f.xv(collar) >= 0.1 * V) {
+            iThroat = collar;
+            atCollar = true;
+        }
+    }
+    if (atCollar) warn("the outline ends at the collar (clothes left out of the silhouette?): throat sought above it");
+    fit.throatAtCollar = atCollar;
 
     // Lip candidates: bulges strictly between the nose and the chin, away from both by 0.04 V (the nose's underside
     // and the chin's own slope), ranked by prominence (depth of the dips on both sides).
@@ -519,6 +551,13 @@ ProfileFit fitProfileFacingRight(const std::vector<cv::Point2d>& outlineIn) {
 }
 
 }  // namespace
+
+bool profileFacesRight(const ProfileFit& right, const ProfileFit& left) {
+    if (!right.ok || !left.ok) return right.ok;
+    // FRMDB 008's curls behind his head made a profile facing back, throat at the collar, more prominent than his face.
+    if (right.throatAtCollar != left.throatAtCollar) return !right.throatAtCollar;
+    return right.noseProminence >= left.noseProminence;
+}
 
 ProfileFit fitProfile(const std::vector<cv::Point2d>& outlineIn, bool noseRight) {
     if (!noseRight) {
@@ -846,10 +885,10 @@ SideAnalysis analyseSidePhoto(const cv::Mat& bgr, const cv::Mat& backgroundPlate
                        "turn more");
     }
 
-    const bool useRight = right.ok && (!left.ok || right.noseProminence >= left.noseProminence);
+    const bool useRight = profileFacesRight(right, left);
     const ProfileFit& fit = useRight ? right : left;
     const ProfileFit& other = useRight ? left : right;
-    if (other.ok && other.noseProminence > 0.7 * fit.noseProminence)
+    if (other.ok && other.throatAtCollar == fit.throatAtCollar && other.noseProminence > 0.7 * fit.noseProminence)
         out.warnings.push_back("facing direction uncertain: both sides of the outline have a nose-like bulge");
     out.noseImageRight = useRight;
     out.landmarks = fit.landmarks;

@@ -38,7 +38,14 @@ struct ProfileFit {
     // profile (a 2 cm nose on a 14.5 cm vertex-to-nose-tip height), near 0 for a front view's silhouette.
     double noseProminence = 0.0;
     std::vector<std::string> warnings;    // points that were estimated rather than found
+    // The outline ended at the collar (clothes left out of the silhouette) and the throat was sought above it: a
+    // weaker profile (the back of big hair can pass as one), which loses to one found without (profileFacesRight).
+    bool throatAtCollar = false;
 };
+
+// Which way a side photo's outline faces, from its fits both ways (at least one ok): the ok one; of two, the one
+// whose throat was found without the collar's help, then the more prominent nose.
+bool profileFacesRight(const ProfileFit& right, const ProfileFit& left);
 
 // Finds the profile landmarks on a head's closed silhouette outline (METHODS §4: extrema and concavities of the
 // profile). The outline is in an image-like frame: y points down, the face points +x (image right), or -x when
