@@ -41,10 +41,11 @@ double meanAbsError(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
 
 }  // namespace
 
-// Measured: mean error over the seen face 2.77 (seed 1) and 3.41 (seed 2) levels of 255, over everything seen 3.79
-// and 4.53. The side photo takes the face's sides from 51 degrees on (PhotoTextureOptions::frontPreference 1.5):
-// unlit, as here, the front photo would give them back better (2.31 and 2.83 with 4, 63 degrees), but lit, as in the
-// booth, its side of the seam is the darker (a dark band down every FRMDB profile's cheek). The former texturing
+// Measured: mean error over the seen face 2.31 (seed 1) and 2.79 (seed 2) levels of 255, over everything seen 3.52
+// and 4.31, with the side photo's exposure matched locally (PhotoTextureOptions::exposureSmoothing; one gain for the
+// whole photo: 2.77 and 3.41, 3.79 and 4.53). The side photo takes the face's sides from 51 degrees on
+// (PhotoTextureOptions::frontPreference 1.5): lit, as in the booth, the front photo's side of the seam is the darker
+// (a dark band down every FRMDB profile's cheek when the seam lay at 63 degrees). The former texturing
 // (both photos averaged by cos^2 of the angle, no visibility test) measured 3.1 and 3.7 on the face: the side photo's
 // nostrils and nose edge showed beside the front photo's.
 TEST(PhotoTextureSynthetic, TextureMatchesThePaintWhereThePhotosSeeIt) {
@@ -69,7 +70,7 @@ TEST(PhotoTextureSynthetic, TextureMatchesThePaintWhereThePhotosSeeIt) {
                     100.0 * t.seenFraction, faceError, seenError);
         EXPECT_GT(t.seenFraction, 0.85) << "seed " << seed;
         EXPECT_GT(cv::countNonZero(seen & face), cv::countNonZero(face) * 95 / 100) << "the photos see almost all the face";
-        EXPECT_LT(faceError, 3.6) << "seed " << seed;
+        EXPECT_LT(faceError, 3.0) << "seed " << seed;
         EXPECT_LT(seenError, 5.0) << "seed " << seed;
         // The fill of the unseen rest stays among the head's colours (hair, skin), not black.
         cv::Mat grey;

@@ -449,6 +449,7 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     cv::Mat frontHalf(half, CV_32FC3, cv::Scalar::all(0)), sideHalf(half, CV_32FC3, cv::Scalar::all(0));
     cv::Mat frontSeen(half, CV_32F, cv::Scalar(0)), sideSeen(half, CV_32F, cv::Scalar(0));
     cv::Mat frontLabel(half, CV_8U, cv::Scalar(0));  // 255 where the blend takes the front photo's bands
+    cv::Mat matchMask(half, CV_32F, cv::Scalar(0));   // 1 on the texels the exposure match compares
     cv::Mat halfSource(half, CV_8U, cv::Scalar(PhotoTexture::Filled));  // the photo each texel takes
     constexpr int kStripes = 16;
     std::array<cv::Vec3d, kStripes> frontSum{}, sideSum{};
@@ -485,6 +486,7 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
                         frontAcc += cv::Vec3d(fc[x][0], fc[x][1], fc[x][2]);
                         sideAcc += cv::Vec3d(sc[x][0], sc[x][1], sc[x][2]);
                         ++overlapAcc;
+                        matchMask.at<float>(y, x) = 1.0f;
                     }
                 }
             }
@@ -521,7 +523,34 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     // the seam, meet plausible colours and no edge. (Filling one photo's gaps with the other photo's colours instead
     // put a hard edge into both images where the two photos' grazing views meet, and no blend can smooth an edge
     // both of its inputs have.)
-    cv::multiply(sideHalf, cv::Scalar(gain[0], gain[1], gain[2]), sideHalf);
+    // The difference is not the same everywhere: the two photos' lights fall differently on the forehead, the
+    // cheeks and the jaw (FRMDB 005's side-photo cheek read pale, 008's a light band beside the seam). So near the
+    // skin both photos see, the gain is local: the same ratio over the compared texels round each texel (Gaussian-
+    // weighted, exposureSmoothing of the texture's side). Further off (the neck, the back of the head, the ears) it
+    // eases into the one gain: continued there, the local gains made blocks of light and shade on 002's neck.
+    cv::Mat gainMap(half, CV_32FC3, cv::Scalar(gain[0], gain[1], gain[2]));
+    if (overlap >= kMinMatchTexels && options.exposureSmoothing > 0.0) {
+        const double sigma = options.exposureSmoothing * half.width;
+        cv::Mat compared, frontNear, sideNear, weightNear;
+        cv::merge(std::vector<cv::Mat>{matchMask, matchMask, matchMask}, compared);
+        cv::GaussianBlur(frontHalf.mul(compared), frontNear, cv::Size(), sigma);
+        cv::GaussianBlur(sideHalf.mul(compared), sideNear, cv::Size(), sigma);
+        cv::GaussianBlur(matchMask, weightNear, cv::Size(), sigma);
+        // Fully local where the comparisons round a texel weigh a quarter of what a texel amid them has.
+        constexpr float kFullyLocal = 0.25f;
+        for (int y = 0; y < half.height; ++y)
+            for (int x = 0; x < half.width; ++x) {
+                const float w = weightNear.at<float>(y, x);
+                if (w < 1e-3f) continue;
+                const float t = std::min(w / kFullyLocal, 1.0f);
+                const float share = t * t * (3.0f - 2.0f * t);
+                const cv::Vec3f f = frontNear.at<cv::Vec3f>(y, x), sd = sideNear.at<cv::Vec3f>(y, x);
+                cv::Vec3f& g = gainMap.at<cv::Vec3f>(y, x);
+                for (int c = 0; c < 3; ++c)
+                    g[c] = share * std::clamp(f[c] / std::max(sd[c], 1e-3f), 0.6f, 1.6f) + (1.0f - share) * gain[c];
+            }
+    }
+    cv::multiply(sideHalf, gainMap, sideHalf);
     const cv::Mat frontSeenHalf = frontSeen > 0.0f, sideSeenHalf = sideSeen > 0.0f;
     cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& r) {
         for (int k = r.start; k < r.end; ++k) pullPushFill(k == 0 ? frontHalf : sideHalf, k == 0 ? frontSeen : sideSeen);
@@ -573,6 +602,7 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
                 const unsigned char* uniformSide = allSide.ptr<unsigned char>(std::min(y / 2, half.height - 1));
                 const unsigned char* frontSeenRow = frontSeenHalf.ptr<unsigned char>(std::min(y / 2, half.height - 1));
                 const unsigned char* sideSeenRow = sideSeenHalf.ptr<unsigned char>(std::min(y / 2, half.height - 1));
+                const cv::Vec3f* gainRow = gainMap.ptr<cv::Vec3f>(std::min(y / 2, half.height - 1));
                 for (int x = 0; x < size.width; ++x) {
                     if (tri[x] >= 0) {
                         ++coveredAcc;
@@ -587,7 +617,8 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
                         }
                         if (uniformSide[hx]) {
                             const cv::Vec3f c = bilinear(side, a.su.at(fx, fyRow), a.sv.at(fx, fyRow));
-                            o[x] = toBgr(cv::Vec3f(c[0] * gain[0], c[1] * gain[1], c[2] * gain[2]) + upsample.at(s0, s1, fy, x));
+                            const cv::Vec3f& gm = gainRow[hx];
+                            o[x] = toBgr(cv::Vec3f(c[0] * gm[0], c[1] * gm[1], c[2] * gm[2]) + upsample.at(s0, s1, fy, x));
                             src[x] = PhotoTexture::Side;
                             ++seenAcc;
                             continue;
@@ -606,7 +637,8 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
                         }
                         if (sideThere) {
                             const cv::Vec3f c = bilinear(side, v.su, v.sv);
-                            o[x] = toBgr(cv::Vec3f(c[0] * gain[0], c[1] * gain[1], c[2] * gain[2]) + upsample.at(s0, s1, fy, x));
+                            const cv::Vec3f& gm = gainRow[hx];
+                            o[x] = toBgr(cv::Vec3f(c[0] * gm[0], c[1] * gm[1], c[2] * gm[2]) + upsample.at(s0, s1, fy, x));
                             src[x] = PhotoTexture::Side;
                             ++seenAcc;
                             continue;

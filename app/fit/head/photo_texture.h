@@ -39,6 +39,9 @@ struct PhotoTextureOptions {
     // Bands of the multi-band blend across the seam (more = a wider, softer transition of the low frequencies): the
     // finest switches at the seam at full resolution, the others are OpenCV's MultiBandBlender at half resolution.
     int blendBands = 5;
+    // The side photo's exposure is matched to the front's locally: over a Gaussian of this share of the texture's
+    // side (about 10 mm on the face at any size); 0: one gain per channel for the whole photo.
+    double exposureSmoothing = 1.0 / 42.0;
     // Depth tolerance of the visibility test in millimetres, on top of what the pixel size and slope allow.
     double depthToleranceMm = 2.0;
     // Where the side photo's ear lies further off than the ears' sliders could move the head's (HeadFit::earLeftMm),
@@ -60,9 +63,9 @@ struct PhotoTexture {
     // photo, 2 the side photo (either side of the head; mirrored for the side it did not see).
     cv::Mat source;     // CV_8U, size x size
     enum Source : unsigned char { Filled = 0, Front = 1, Side = 2 };
-    // The per-channel (B, G, R) gain the side photo's colours took to match the front photo's exposure and white
-    // balance, and how many half-resolution texels of skin both photos saw it was measured on (0: too few to
-    // measure, gain 1).
+    // The per-channel (B, G, R) gain that matches the side photo's colours to the front photo's exposure and white
+    // balance over all the skin both saw, and how many half-resolution texels that was (0: too few to measure, gain
+    // 1). Each texel takes the gain measured near it (PhotoTextureOptions::exposureSmoothing); this is the whole's.
     cv::Vec3f sideGain{1.0f, 1.0f, 1.0f};
     int sideGainTexels = 0;
 };
