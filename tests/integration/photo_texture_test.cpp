@@ -41,8 +41,8 @@ double meanAbsError(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
 
 }  // namespace
 
-// Measured: mean error over the seen face 2.31 (seed 1) and 2.79 (seed 2) levels of 255, over everything seen 3.52
-// and 4.31, with the side photo's exposure matched locally (PhotoTextureOptions::exposureSmoothing; one gain for the
+// Measured: mean error over the seen face 2.32 (seed 1) and 2.81 (seed 2) levels of 255, over everything seen 3.44
+// and 4.21, with the side photo's exposure matched locally (PhotoTextureOptions::exposureSmoothing; one gain for the
 // whole photo: 2.77 and 3.41, 3.79 and 4.53). The side photo takes the face's sides from 51 degrees on
 // (PhotoTextureOptions::frontPreference 1.5): lit, as in the booth, the front photo's side of the seam is the darker
 // (a dark band down every FRMDB profile's cheek when the seam lay at 63 degrees). The former texturing
