@@ -301,12 +301,13 @@ cv::Point2d estimateEarHole(const cv::Point2d& nasion, const cv::Point2d& chin, 
 
 namespace {
 
-// Where the front chain reaches the collar when the clothes are not in the outline, below `from` and no further than
-// `to`: the chain's end when it stops short of `to` (the outline's lowest level is the neck's cut), else the first
-// point at least `minY` down from which the chain runs back along the collar (0.25 V back while dropping less than
-// 0.05 V: long hair hangs lower at the back). -1 when neither.
-int collarIndex(const Chain& f, int from, int to, double minY, double V) {
-    if (to == f.size() - 1 && f.y(to) >= minY) return to;
+// Where the front chain reaches the collar when the clothes are not in the outline, after `from` and at least `minY`
+// down: the chain's end when the walk down to the neck (`neckLow`) stopped there short of its level (the outline's
+// lowest level is the neck's cut), else the first point from which the chain runs back along the collar (0.25 V back
+// while dropping less than 0.05 V: long hair hangs lower at the back), anywhere down the rest of the chain. -1 when
+// neither.
+int collarIndex(const Chain& f, int from, int neckLow, double minY, double V) {
+    if (neckLow == f.size() - 1 && f.y(neckLow) >= minY) return neckLow;
     for (int i = from + 1; i < f.size(); ++i) {
         if (f.y(i) < minY) continue;
         for (int j = i + 1; j < f.size() && f.y(j) - f.y(i) <= 0.05 * V; ++j)

@@ -14,6 +14,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <vector>
 
 namespace avatarbooth {
 namespace {
@@ -201,9 +203,11 @@ double plateThreshold(const cv::Mat& bgr, const cv::Mat& plate, const cv::Mat& b
 // The top strip and the upper 55% of the left and right strips (3% of the short side wide): taken as background.
 // The bottom is not (shoulders and long hair run out of the frame there), nor the lower sides (a front photo's
 // shoulders may run out of the frame at the sides: the scan's front render does, from 78% of the height down).
+int borderWidth(cv::Size size) { return std::max(2, static_cast<int>(std::lround(0.03 * std::min(size.width, size.height)))); }
+
 cv::Mat borderStrips(cv::Size size) {
     cv::Mat m = cv::Mat::zeros(size, CV_8U);
-    const int w = std::max(2, static_cast<int>(std::lround(0.03 * std::min(size.width, size.height))));
+    const int w = borderWidth(size);
     const int sideEnd = static_cast<int>(0.55 * size.height);
     m.rowRange(0, w).setTo(255);
     m(cv::Rect(0, 0, w, sideEnd)).setTo(255);
@@ -270,33 +274,38 @@ cv::Mat warmMask(const cv::Mat& bgr) {
     return m;
 }
 
+// How rare a colour must be under `model` to stand out from the pixels of `mask` the model was learnt on: rarer
+// (-log p) than all but their rarest 0.5 %, plus 1 nat. Infinite when the mask is empty.
+float rarityLimit(const ColourModel& model, const cv::Mat& bins, const cv::Mat& mask) {
+    std::vector<float> rarity;
+    for (int y = 0; y < bins.rows; ++y) {
+        const auto* b = bins.ptr<std::uint16_t>(y);
+        const auto* m = mask.ptr<std::uint8_t>(y);
+        for (int x = 0; x < bins.cols; ++x)
+            if (m[x]) rarity.push_back(-model.logDensity[b[x]]);
+    }
+    if (rarity.empty()) return std::numeric_limits<float>::infinity();
+    const auto q = rarity.begin() + static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(rarity.size() - 1));
+    std::nth_element(rarity.begin(), q, rarity.end());
+    return *q + 1.0f;
+}
+
 // The border strips' pixels that are background without a plate. The left and right strips are; the top strip may
 // hold a tall visitor's hair (the head at the frame's top edge: a synthetic visitor's brown hair, learnt as the
 // backdrop's colour, was left out of both silhouettes and the head cut off at the hairline). The top strip's warm
-// pixels (skin; brown, black, blond, red hair: warmMask) count only where the side strips' colours hold them likely:
-// not rarer there than all but the side strips' rarest 0.5 %, plus 1 nat (the seeds' test below). Its cold ones
+// pixels (skin; brown, black, blond, red hair: warmMask) count only where the side strips' colours hold them likely
+// (within their rarityLimit, as the seeds' test below). Its cold ones
 // count as they are (a lit fold of a blue cloth at the top is the backdrop; left out, FRMDB 008's curls behind his
 // head read as a second profile in the side guide).
 cv::Mat backgroundBorder(const cv::Mat& small, const cv::Mat& bins) {
-    const cv::Mat strips = borderStrips(bins.size());
-    const int w = std::max(2, static_cast<int>(std::lround(0.03 * std::min(bins.cols, bins.rows))));
-    cv::Mat sides = strips.clone();
+    const int w = borderWidth(bins.size());
+    cv::Mat sides = borderStrips(bins.size());
     sides.rowRange(0, w).setTo(0);
     sides(cv::Rect(0, 0, w, w)).setTo(255);
     sides(cv::Rect(bins.cols - w, 0, w, w)).setTo(255);
     ColourModel sideModel;
     sideModel.build(bins, sides, 2, kBgFloor);
-    std::vector<float> rarity;
-    for (int y = 0; y < bins.rows; ++y) {
-        const auto* b = bins.ptr<std::uint16_t>(y);
-        const auto* m = sides.ptr<std::uint8_t>(y);
-        for (int x = 0; x < bins.cols; ++x)
-            if (m[x]) rarity.push_back(-sideModel.logDensity[b[x]]);
-    }
-    if (rarity.empty()) return strips;
-    const auto q = rarity.begin() + static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(rarity.size() - 1));
-    std::nth_element(rarity.begin(), q, rarity.end());
-    const float limit = *q + 1.0f;
+    const float limit = rarityLimit(sideModel, bins, sides);
     cv::Mat border = sides.clone();
     const cv::Mat warm = warmMask(small.rowRange(0, w));
     for (int y = 0; y < w; ++y) {
@@ -373,19 +382,12 @@ cv::Mat segmentPerson(const cv::Mat& bgr, const cv::Mat& backgroundPlate, cv::Re
         // blue cloth is as rare on the border as a face; clothes of any colour join in the later rounds when they
         // connect to the person and are unlike the background.
         cv::Mat unlike(small.size(), CV_32F);
-        std::vector<float> borderU;
         for (int y = 0; y < small.rows; ++y) {
             const auto* b = bins.ptr<std::uint16_t>(y);
             auto* u = unlike.ptr<float>(y);
-            const auto* br = border.ptr<std::uint8_t>(y);
-            for (int x = 0; x < small.cols; ++x) {
-                u[x] = -bgModel.logDensity[b[x]];
-                if (br[x]) borderU.push_back(u[x]);
-            }
+            for (int x = 0; x < small.cols; ++x) u[x] = -bgModel.logDensity[b[x]];
         }
-        const auto q = borderU.begin() + static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(borderU.size() - 1));
-        std::nth_element(borderU.begin(), q, borderU.end());
-        const float uThr = *q + 1.0f;
+        const float uThr = rarityLimit(bgModel, bins, border);
         cv::Mat seed = (unlike > uThr) & (border == 0) & warmMask(small);
         if (!hintSmall.empty()) seed |= hintSmall;
         if (cv::countNonZero(seed) < 0.002 * areaSmall)

@@ -190,6 +190,12 @@ cv::Mat interiorOf(const cv::Mat& mask) {
 }
 
 // Whether a photo's pixel at (u, v) is skin by the not-skin mask (no mask: every pixel of the person counts).
+// 0 at t <= 0 rising smoothly (no kink at either end) to 1 at t >= 1: the fades of the shifts, gains and repaints.
+double smoothstep(double t) {
+    t = std::clamp(t, 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
 // Where the side photo is read for a point of the head (pixels), shifted from the profile's projection:
 // - Turned short of the profile (or past it), the side photo shows the side of the head further back (or forward)
 //   than a profile would; the outline, which the fit matched, stays. The side photo's eye measures it
@@ -200,7 +206,6 @@ cv::Mat interiorOf(const cv::Mat& mask) {
 //   earReachMm of the ear's middle, fading out over earFadeMm or twice the shift if more, so that the reading cannot
 //   fold); both ears, as the photo stands in for the far side too.
 cv::Point2d sidePhotoPoint(const HeadFit& fit, const PhotoTextureOptions& options, const glm::dvec3& p) {
-    const auto smoothstep = [](double t) { return t * t * (3.0 - 2.0 * t); };
     // The feature on p's side of the head (the photo stands in for both).
     const auto onSideOf = [&](const glm::dvec3& m) { return (p.x < 0.0) == (m.x < 0.0) ? m : glm::dvec3(-m.x, m.y, m.z); };
     double ear = 0.0;  // the ear's share
@@ -548,8 +553,7 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
         cv::Mat local(coarse, CV_32FC3);
         for (int y = 0; y < coarse.height; ++y)
             for (int x = 0; x < coarse.width; ++x) {
-                const float t = std::min(weightNear.at<float>(y, x) / kFullyLocal, 1.0f);
-                const float share = t * t * (3.0f - 2.0f * t);
+                const auto share = static_cast<float>(smoothstep(weightNear.at<float>(y, x) / kFullyLocal));
                 const cv::Vec3f f = frontNear.at<cv::Vec3f>(y, x), sd = sideNear.at<cv::Vec3f>(y, x);
                 cv::Vec3f& g = local.at<cv::Vec3f>(y, x);
                 for (int c = 0; c < 3; ++c) {
@@ -682,9 +686,7 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
     // How much a point is on the face's sides: 1 inside, fading out above, behind and under them.
     const auto fadeOut = [&](double beyond) {
         if (beyond <= 0.0) return 1.0;
-        if (sides.fadeMm <= 0.0 || beyond >= sides.fadeMm) return 0.0;
-        const double t = beyond / sides.fadeMm;
-        return 1.0 - t * t * (3.0 - 2.0 * t);
+        return sides.fadeMm > 0.0 ? 1.0 - smoothstep(beyond / sides.fadeMm) : 0.0;
     };
     const auto onSides = [&](const glm::dvec3& p) {
         if (std::abs(p.x) < sides.innerX) return 0.0;
