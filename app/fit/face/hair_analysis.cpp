@@ -467,11 +467,15 @@ cv::Mat hairPixels(const cv::Mat& bgr, const cv::Mat& personMask, const HairEsti
     checkPhoto(bgr, personMask, "photo");
     cv::Mat out(bgr.size(), CV_8U, cv::Scalar(0));
     if (estimate.style == HairStyle::None) return out;
-    const cv::Mat lab = toLab(bgr);
-    for (int y = 0; y < bgr.rows; ++y)
-        for (int x = 0; x < bgr.cols; ++x)
-            if (personMask.at<std::uint8_t>(y, x) && isHairColour(lab.at<cv::Vec3f>(y, x), estimate.hairLab, estimate.skinLab))
-                out.at<std::uint8_t>(y, x) = 255;
+    // Only the person's pixels can be hair: the box round them is converted, not the whole frame.
+    const cv::Rect box = cv::boundingRect(personMask);
+    if (box.empty()) return out;
+    const cv::Mat lab = toLab(bgr(box));
+    for (int y = 0; y < box.height; ++y)
+        for (int x = 0; x < box.width; ++x)
+            if (personMask.at<std::uint8_t>(box.y + y, box.x + x) &&
+                isHairColour(lab.at<cv::Vec3f>(y, x), estimate.hairLab, estimate.skinLab))
+                out.at<std::uint8_t>(box.y + y, box.x + x) = 255;
     return out;
 }
 

@@ -26,13 +26,23 @@ std::pair<glm::dvec2, glm::dvec2> rowDirections(const ModifierTarget& t) {
     return {glm::dvec2(std::sqrt(t.weight.x), 0.0), glm::dvec2(0.0, std::sqrt(t.weight.y))};
 }
 
+// The indices of x's nonzero elements. Most modifiers sit at their bound 0, so the sums below run over these alone:
+// the terms left out are exact zeros, and the sums are the same to the last bit.
+void nonzeroIndices(const std::vector<double>& x, std::vector<std::size_t>& out) {
+    out.clear();
+    for (std::size_t j = 0; j < x.size(); ++j)
+        if (x[j] != 0.0) out.push_back(j);
+}
+
 // 1/2 x^T N x - g^T x, N dense n x n row-major.
-double objective(const std::vector<double>& N, const std::vector<double>& g, const std::vector<double>& x) {
+double objective(const std::vector<double>& N, const std::vector<double>& g, const std::vector<double>& x,
+                 std::vector<std::size_t>& nonzero) {
     const std::size_t n = x.size();
+    nonzeroIndices(x, nonzero);
     double f = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
+    for (const std::size_t i : nonzero) {
         double s = 0.0;
-        for (std::size_t j = 0; j < n; ++j) s += N[i * n + j] * x[j];
+        for (const std::size_t j : nonzero) s += N[i * n + j] * x[j];
         f += x[i] * (0.5 * s - g[i]);
     }
     return f;
@@ -46,15 +56,17 @@ void minimiseInBox(const std::vector<double>& N, const std::vector<double>& g, c
                    const std::vector<double>& hi, std::vector<double>& x, int maxSteps) {
     const std::size_t n = x.size();
     for (std::size_t i = 0; i < n; ++i) x[i] = std::clamp(x[i], lo[i], hi[i]);
-    double f = objective(N, g, x);
+    std::vector<std::size_t> nonzero;
+    double f = objective(N, g, x, nonzero);
     std::vector<double> gradient(n), next(n);
     std::vector<std::size_t> free;
     for (int step = 0; step < maxSteps; ++step) {
         free.clear();
+        nonzeroIndices(x, nonzero);
         double largest = 0.0;
         for (std::size_t i = 0; i < n; ++i) {
             double s = -g[i];
-            for (std::size_t j = 0; j < n; ++j) s += N[i * n + j] * x[j];
+            for (const std::size_t j : nonzero) s += N[i * n + j] * x[j];
             gradient[i] = s;
             if ((x[i] <= lo[i] && s >= 0.0) || (x[i] >= hi[i] && s <= 0.0)) continue;
             free.push_back(i);
@@ -78,7 +90,7 @@ void minimiseInBox(const std::vector<double>& N, const std::vector<double>& g, c
                 next[i] = std::clamp(x[i] + alpha * d(a), lo[i], hi[i]);
                 decrease += gradient[i] * (next[i] - x[i]);
             }
-            fNext = objective(N, g, next);
+            fNext = objective(N, g, next, nonzero);
             if (fNext <= f + 1e-4 * decrease) break;
         }
         if (!(fNext < f)) return;  // no step decreases it any more (rounding)
