@@ -98,7 +98,7 @@ std::optional<std::pair<cv::Point2d, double>> templatePeak(const SideCrop& c, co
     const double blur = std::max(0.5, 0.6 * pxPerMm);
     cv::GaussianBlur(grey, grey, {0, 0}, blur);
     const auto [pc, ps] = edgeDirections(grey, 0.05);
-    // The sizes' correlations are most of the locator's time (10 ms a size on FRMDB's profiles): one thread each.
+    // The sizes' correlations are most of the locator's time: each on a thread of its own.
     std::vector<SizedScore> sizes(o.scales.size());
     cv::parallel_for_(cv::Range(0, static_cast<int>(sizes.size())), [&](const cv::Range& r) {
         for (int i = r.start; i < r.end; ++i)
