@@ -251,6 +251,11 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
     out.partColours = measurePartColours(front, out.frontLandmarks);
     out.parts = placeParts(base_, out.fit.mesh, out.texture.texture, out.partColours);
     if (auto hair = placeHairPart(base_, out.fit.mesh, out.hair)) {
+        // A bob as long behind the head as the side photo shows it, before its outline is fitted. (Long hair runs
+        // past the bust's cut in the photos, and where it lies over the shoulders the band behind the neck shows
+        // clothes: read there, it shortened long01 by a tenth on every long-haired FRMDB pair.)
+        if (out.hair.style == HairStyle::Bob)
+            out.hairLength = fitHairLengthBehind(hair->mesh, out.fit.mesh, out.fit.side, m.sideHair, jawTopDepth(base_, out.fit.mesh));
         // Big hair is as full as the photos show it (short hair is in the head's own outline already).
         if (isBigHair(out.hair.style)) {
             HairSilhouetteFit follow;

@@ -18,6 +18,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <optional>
 #include <cmath>
@@ -227,6 +228,18 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
                     if (hair > skin) hidden.push_back(up);  // NaN: no hair there
                 }
             EXPECT_TRUE(hidden.empty()) << "the forehead behind hair at " << ::testing::PrintToString(hidden) << " mm over the brows";
+            // 008's curls hang to his collar behind the head in both profiles (read off the photos by eye), 20 mm and
+            // more under bob02's ends, which left them painted on his neck under the bob: the bob now hangs as low as
+            // the side photo's hair, behind the head.
+            const HairLength& length = outcome.hairLength;
+            double lowestBehind = std::numeric_limits<double>::infinity();
+            for (const glm::dvec3& q : part.mesh.positions)
+                if (q.z < HairLengthFit{}.behindZ) lowestBehind = std::min(lowestBehind, q.y);
+            std::printf("%s %s: the photo's hair behind the head down to %.1f mm, bob02's to %.1f: length x %.2f, now down to %.1f\n",
+                        person, std::get<1>(GetParam()), length.photoBottom, length.avatarBottom, length.factor, lowestBehind);
+            EXPECT_TRUE(length.measured);
+            EXPECT_LT(length.photoBottom, length.avatarBottom - 15.0);
+            EXPECT_NEAR(lowestBehind, length.photoBottom, 1.0);
         }
         // Seen from either side, the head shows nowhere through long hair or a bob: the fitted head's ears stood out
         // through long01 and were drawn as an arc on the hair (005, 006, 007) until tuckEarsUnderHair. Short hair and

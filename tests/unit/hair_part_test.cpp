@@ -160,6 +160,58 @@ TEST(HairPart, HairWithinTheHeadsOutlineAndAPonytailsBackStayPut) {
 
 namespace {
 
+// A side photo's hair over the band behind the head (z -110 to -10 at 1 mm a pixel, frame()), from y 50 down to
+// `bottom`, and a few stray hair pixels 30 mm under it (a lone curl, noise).
+cv::Mat hairBehindDownTo(double bottom) {
+    cv::Mat m = cv::Mat::zeros(400, 400, CV_8U);
+    m(cv::Range(200 - 50, 200 - static_cast<int>(bottom) + 1), cv::Range(200 - 110, 200 - 10 + 1)).setTo(255);
+    m(cv::Range(200 - static_cast<int>(bottom) + 30, 200 - static_cast<int>(bottom) + 33), cv::Range(140, 146)).setTo(255);
+    return m;
+}
+
+}  // namespace
+
+TEST(HairPart, ABobHangsBehindTheHeadAsFarDownAsTheSidePhotoShowsItsHair) {
+    // The head down to the bust's cut at y -130; the bob's back (z -110) and front (z 50, beside the face) down to
+    // y -60; the jaw's top at z 20. The photo's hair behind the head ends at y -85.
+    const Mesh head = walls(-60.0, 60.0, -80.0, 80.0, {-130.0, 100.0});
+    Mesh hair = walls(-90.0, 90.0, -110.0, 50.0, {-60.0, 0.0, 50.0});
+    const Mesh before = hair;
+    const HairLength length = fitHairLengthBehind(hair, head, frame(), hairBehindDownTo(-85.0), 20.0);
+    ASSERT_TRUE(length.measured);
+    EXPECT_NEAR(length.photoBottom, -85.0, 1.0);
+    EXPECT_NEAR(length.avatarBottom, -60.0, 1e-9);
+    EXPECT_NEAR(length.factor, 85.0 / 60.0, 0.02);
+    for (std::size_t i = 0; i < hair.positions.size(); ++i) {
+        const glm::dvec3& p = hair.positions[i];
+        const glm::dvec3& q = before.positions[i];
+        EXPECT_EQ(p.x, q.x) << i;
+        EXPECT_EQ(p.z, q.z) << i;
+        if (q.y >= 0.0 || q.z >= 20.0) EXPECT_EQ(p.y, q.y) << i;  // over the ear holes, and the locks beside the face
+        else EXPECT_NEAR(p.y, -85.0, 1.0) << i;                    // the back's ends, to the photo's
+    }
+
+    // Shorter in the photo: measured, but the hair is only ever lengthened (HairLengthFit::minFactor); far longer:
+    // no further than the factor's limit.
+    Mesh shorter = before;
+    const HairLength up = fitHairLengthBehind(shorter, head, frame(), hairBehindDownTo(-50.0), 20.0);
+    EXPECT_NEAR(up.photoBottom, -50.0, 1.0);
+    EXPECT_EQ(up.factor, 1.0);
+    EXPECT_EQ(shorter.positions, before.positions);
+    Mesh longer = before;
+    const HairLength capped = fitHairLengthBehind(longer, head, frame(), hairBehindDownTo(-125.0), 20.0);
+    EXPECT_EQ(capped.factor, HairLengthFit{}.maxFactor);
+    EXPECT_NEAR(longer.positions[0].y, -60.0 * HairLengthFit{}.maxFactor, 1e-9);
+
+    // No hair behind the head in the photo (or no mask): nothing is measured and nothing moves.
+    Mesh untouched = before;
+    EXPECT_FALSE(fitHairLengthBehind(untouched, head, frame(), cv::Mat::zeros(400, 400, CV_8U), 20.0).measured);
+    EXPECT_FALSE(fitHairLengthBehind(untouched, head, frame(), cv::Mat(), 20.0).measured);
+    EXPECT_EQ(untouched.positions, before.positions);
+}
+
+namespace {
+
 // Two layers of hair beside the head on the +x side, flat sheets at x 80 (inner) and 84 (outer) over y -20..30 and
 // z -25..20; on the -x side none.
 Mesh hairSheetsOverTheLeftEar() {

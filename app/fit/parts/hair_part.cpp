@@ -484,6 +484,55 @@ std::vector<HairStretch> fitHairToSilhouettes(Mesh& hair, const Mesh& fittedHead
     return out;
 }
 
+HairLength fitHairLengthBehind(Mesh& hair, const Mesh& fittedHead, const PhotoFrame& side, const cv::Mat& sideHair,
+                               double jawZ, const HairLengthFit& o) {
+    HairLength out;
+    if (sideHair.empty() || sideHair.type() != CV_8U || hair.positions.empty() || fittedHead.positions.empty() ||
+        o.step <= 0.0 || side.mmPerPixel <= 0.0)
+        return out;
+    glm::dvec3 headLo, headHi;
+    fittedHead.bounds(headLo, headHi);
+    // The band behind the head: from the hair part's back to behindZ; the hair part's lowest point in it.
+    double back = std::numeric_limits<double>::infinity(), avatarBottom = std::numeric_limits<double>::infinity();
+    for (const glm::dvec3& p : hair.positions)
+        if (p.z < o.behindZ) back = std::min(back, p.z), avatarBottom = std::min(avatarBottom, p.y);
+    if (!std::isfinite(back) || avatarBottom >= 0.0) return out;
+    // The photo's hair, height by height down from the ear holes: the share of the band that is hair.
+    const auto share = [&](double y) {
+        int hairy = 0, read = 0;
+        for (double z = back; z <= o.behindZ; z += o.step) {
+            const cv::Point2d px = side.toPixel({z, y});
+            const int c = static_cast<int>(std::lround(px.x)), r = static_cast<int>(std::lround(px.y));
+            if (c < 0 || r < 0 || c >= sideHair.cols || r >= sideHair.rows) continue;
+            ++read;
+            hairy += sideHair.at<std::uint8_t>(r, c) != 0;
+        }
+        return read > 0 ? static_cast<double>(hairy) / read : 0.0;
+    };
+    double photoBottom = std::numeric_limits<double>::quiet_NaN();
+    for (double y = 0.0, sinceHair = 0.0; y >= headLo.y - o.gap && sinceHair < o.gap; y -= o.step) {
+        if (share(y) >= o.rowShare) {
+            photoBottom = y;
+            sinceHair = 0.0;
+        } else {
+            sinceHair += o.step;
+        }
+    }
+    if (std::isnan(photoBottom)) return out;  // no hair behind the head under the ear holes (or none read)
+    out.measured = true;
+    out.photoBottom = std::max(photoBottom, headLo.y);
+    out.avatarBottom = avatarBottom;
+    out.factor = std::clamp(out.photoBottom / avatarBottom, o.minFactor, o.maxFactor);
+    if (out.factor == 1.0) return out;
+    const double fade = std::max(jawZ - o.behindZ, 1e-6);
+    for (glm::dvec3& p : hair.positions) {
+        if (p.y >= 0.0) continue;
+        const double t = std::clamp((jawZ - p.z) / fade, 0.0, 1.0);  // 1 behind behindZ, 0 from the jaw's top on
+        p.y *= 1.0 + (out.factor - 1.0) * t * t * (3.0 - 2.0 * t);
+    }
+    return out;
+}
+
 const char* hairProxyName(HairStyle style) {
     switch (style) {
         case HairStyle::None: return nullptr;

@@ -111,6 +111,37 @@ std::vector<HairStretch> fitHairToSilhouettes(Mesh& hair, const Mesh& fittedHead
                                               const cv::Mat& frontMask, const PhotoFrame& side, const cv::Mat& sideMask,
                                               double chinY, const HairSilhouetteFit& options = {});
 
+// How far down the hair hangs behind the head (fitHairLengthBehind), in millimetres of head space (the ear holes'
+// middle at the origin, y up, z forward).
+struct HairLengthFit {
+    double behindZ = -10.0;   // hair behind this depth hangs behind the head; from it to the jaw's top the change fades
+    double rowShare = 0.2;    // a height holds the photo's hair where this share of the band behind the head is hair
+    double gap = 6.0;         // going down, the photo's hair ends at the first run of heights this long without it
+    double step = 1.0;        // the band is read every this many millimetres, across and down
+    // Only lengthened: the photo's hair mask loses the strands' thin ends against the backdrop, so it reads hair
+    // shorter than it is (a synthetic visitor's bob02 by 11 mm of 64), never longer.
+    double minFactor = 1.0, maxFactor = 1.6;
+};
+
+// What fitHairLengthBehind measured (for fit.json and tests): the lowest height of the photo's hair behind the head
+// and of the hair part's, and the factor the hair part's length under the ear holes was scaled by (1: unchanged).
+struct HairLength {
+    bool measured = false;
+    double photoBottom = 0.0, avatarBottom = 0.0;
+    double factor = 1.0;
+};
+
+// A bob or long hair is MakeHuman's length; the visitor's ends higher or lower at the back (FRMDB 008's curls hang
+// to his collar, under bob02's ends: the side photo's curls were painted on his neck under the hair). The side
+// photo's hair (CV_8U, 255 on hair, the photo as taken; `side`: its frame) is read across the band behind the head
+// (from the hair part's back to `behindZ`), height by height down from the ear holes; where it ends, the hair
+// part's lowest point behind the head goes when that is lower, by scaling the hair's heights under the ear holes
+// (y' = k y, k within [minFactor, maxFactor]), in full behind `behindZ` and fading out (smoothstep) towards `jawZ`, so that the locks
+// beside the face keep their length. Never below the fitted head's lowest point (the bust's cut). Heights map
+// monotonically, so no triangle turns over.
+HairLength fitHairLengthBehind(Mesh& hair, const Mesh& fittedHead, const PhotoFrame& side, const cv::Mat& sideHair,
+                               double jawZ, const HairLengthFit& options = {});
+
 // What the photos show of the hair (hairPixels: CV_8U, 255 on hair, in each photo as taken, with its person mask)
 // and how their pixels map to the head (the fit's frames).
 struct HairPhotoMasks {
