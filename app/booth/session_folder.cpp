@@ -119,7 +119,7 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
             stretch.push_back({{"y_mm", s.y}, {"plus_x", s.plusX}, {"minus_x", s.minusX}, {"back", s.back}});
         }
         report["hair"]["stretch"] = stretch;
-        if (o.hairLength.measured)  // a bob's or long hair's length behind the head, to the side photo's
+        if (o.hairLength.measured)  // a bob's length behind the head, to the side photo's
             report["hair"]["length_behind"] = {{"photo_bottom_mm", o.hairLength.photoBottom},
                                                {"avatar_bottom_mm", o.hairLength.avatarBottom},
                                                {"factor", o.hairLength.factor}};

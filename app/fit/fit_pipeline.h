@@ -70,7 +70,7 @@ struct FitOutcome {
     // With short hair: how many of the hair part's vertices went where the photos show skin (fit/parts/hair_part.h
     // trimShortHairToPhotos); 0 otherwise.
     int hairTrimmedVertices = 0;
-    // With a bob or long hair: how far down the side photo shows the hair behind the head, and how the hair part's
+    // With a bob: how far down the side photo shows the hair behind the head, and how the hair part's
     // length was scaled to it (fitHairLengthBehind); not measured otherwise.
     HairLength hairLength;
     // How big hair was stretched to the photos' outlines, band by band (fitHairToSilhouettes); empty otherwise.

@@ -1,5 +1,6 @@
 #include "fit/head/ears.h"
 
+#include "common/smoothstep.h"
 #include "fit/head/view_depth.h"
 
 #include <opencv2/imgproc.hpp>
@@ -157,7 +158,7 @@ std::vector<std::pair<std::uint32_t, glm::dvec3>> earDisplacements(const Modifie
             const double t = std::clamp((share - kEarMoveFadesTo) / (0.99 - kEarMoveFadesTo), 0.0, 1.0);
             if (t <= 0.0) continue;
             // The offset's direction at the ear's full length, by the smooth step of its share.
-            const double along = t * t * (3.0 - 2.0 * t) * longest / glm::length(offset);
+            const double along = smoothstep(t) * longest / glm::length(offset);
             moved[m.vertices[i]] += placement.weights[k] * along * offset * axisScale;
         }
     }

@@ -9,6 +9,7 @@
 #include "fit/head/photo_texture.h"
 
 #include "common/error.h"
+#include "common/smoothstep.h"
 #include "fit/head/surface_texels.h"
 #include "fit/head/view_depth.h"
 
@@ -189,13 +190,6 @@ cv::Mat interiorOf(const cv::Mat& mask) {
     return inner;
 }
 
-// Whether a photo's pixel at (u, v) is skin by the not-skin mask (no mask: every pixel of the person counts).
-// 0 at t <= 0 rising smoothly (no kink at either end) to 1 at t >= 1: the fades of the shifts, gains and repaints.
-double smoothstep(double t) {
-    t = std::clamp(t, 0.0, 1.0);
-    return t * t * (3.0 - 2.0 * t);
-}
-
 // Where the side photo is read for a point of the head (pixels), shifted from the profile's projection:
 // - Turned short of the profile (or past it), the side photo shows the side of the head further back (or forward)
 //   than a profile would; the outline, which the fit matched, stays. The side photo's eye measures it
@@ -224,6 +218,7 @@ cv::Point2d sidePhotoPoint(const HeadFit& fit, const PhotoTextureOptions& option
     return fit.side.toPixel(glm::dvec2(p.z, p.y) + shift);
 }
 
+// Whether a photo's pixel at (u, v) is skin by the not-skin mask (no mask: every pixel of the person counts).
 bool isSkin(const cv::Mat& notSkin, float u, float v) {
     if (notSkin.empty()) return true;
     const int x = std::clamp(static_cast<int>(std::lround(u)), 0, notSkin.cols - 1);

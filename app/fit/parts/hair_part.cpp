@@ -4,6 +4,7 @@
 #include "common/booth_lights.h"
 #include "common/error.h"
 #include "common/landmark_names.h"
+#include "common/smoothstep.h"
 #include "fit/parts/avatar_parts.h"
 
 #include <opencv2/core.hpp>
@@ -51,7 +52,7 @@ void keepFaceClear(Mesh& hair, const BaseHead& base, const Mesh& fittedHead, con
         // layered as they were, not collapsed onto one flat wall.
         const double ahead = p.z - sideZ;
         const double kept = clearance.depth * (1.0 - std::exp(-ahead / clearance.depth));
-        p.z -= t * t * (3.0 - 2.0 * t) * (ahead - kept);
+        p.z -= smoothstep(t) * (ahead - kept);
     }
 }
 
@@ -455,7 +456,7 @@ std::vector<HairStretch> fitHairToSilhouettes(Mesh& hair, const Mesh& fittedHead
         // Over the skull's top the head's slices shrink to nothing and their edges say little: the stretch fades out
         // over the top `crown` millimetres of the head (stretched there, the crown's hair sank under the scalp).
         const double u = std::clamp((hi.y - h.y - o.crown * 0.25) / (o.crown * 0.75), 0.0, 1.0);
-        const double fade = u * u * (3.0 - 2.0 * u);
+        const double fade = smoothstep(u);
         double* ks[3] = {&h.plusX, &h.minusX, &h.back};
         for (int c = 0; c < 3; ++c) {
             *ks[c] = 1.0 + fade * ((kw[c] > 1e-6 ? k[c] / kw[c] : 1.0) - 1.0);
@@ -528,7 +529,7 @@ HairLength fitHairLengthBehind(Mesh& hair, const Mesh& fittedHead, const PhotoFr
     for (glm::dvec3& p : hair.positions) {
         if (p.y >= 0.0) continue;
         const double t = std::clamp((jawZ - p.z) / fade, 0.0, 1.0);  // 1 behind behindZ, 0 from the jaw's top on
-        p.y *= 1.0 + (out.factor - 1.0) * t * t * (3.0 - 2.0 * t);
+        p.y *= 1.0 + (out.factor - 1.0) * smoothstep(t);
     }
     return out;
 }

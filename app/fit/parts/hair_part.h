@@ -131,14 +131,14 @@ struct HairLength {
     double factor = 1.0;
 };
 
-// A bob or long hair is MakeHuman's length; the visitor's ends higher or lower at the back (FRMDB 008's curls hang
-// to his collar, under bob02's ends: the side photo's curls were painted on his neck under the hair). The side
-// photo's hair (CV_8U, 255 on hair, the photo as taken; `side`: its frame) is read across the band behind the head
-// (from the hair part's back to `behindZ`), height by height down from the ear holes; where it ends, the hair
-// part's lowest point behind the head goes when that is lower, by scaling the hair's heights under the ear holes
-// (y' = k y, k within [minFactor, maxFactor]), in full behind `behindZ` and fading out (smoothstep) towards `jawZ`, so that the locks
+// A bob is MakeHuman's length; the visitor's hair may hang lower at the back (FRMDB 008's curls hang to his collar,
+// under bob02's ends: the side photo's curls were painted on his neck under the hair). The side photo's hair (CV_8U,
+// 255 on hair, the photo as taken; `side`: its frame) is read across the band behind the head (from the hair part's
+// back to `behindZ`), height by height down from the ear holes; where it ends, the hair part's lowest point behind
+// the head goes when that is lower, by scaling the hair's heights under the ear holes (y' = k y, k within
+// [minFactor, maxFactor]), in full behind `behindZ` and fading out (smoothstep) towards `jawZ`, so that the locks
 // beside the face keep their length. Never below the fitted head's lowest point (the bust's cut). Heights map
-// monotonically, so no triangle turns over.
+// monotonically, so no triangle turns over. (The fit reads long hair no longer: fit_pipeline.cpp says why.)
 HairLength fitHairLengthBehind(Mesh& hair, const Mesh& fittedHead, const PhotoFrame& side, const cv::Mat& sideHair,
                                double jawZ, const HairLengthFit& options = {});
 
