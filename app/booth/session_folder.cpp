@@ -64,6 +64,10 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
     // B, G, R, as the side photo's colours were scaled to the front's exposure (1 when too little skin was seen).
     report["texture_side_gain"] = {o.texture.sideGain[0], o.texture.sideGain[1], o.texture.sideGain[2]};
     report["texture_side_gain_texels"] = o.texture.sideGainTexels;
+    // Texels (of the texture's size squared) repainted with skin: the photos' hair beside the face, their clothes
+    // round the bottom of the neck.
+    report["texture_skin_over_hair_texels"] = o.skinOverHairTexels;
+    report["texture_skin_over_clothes_texels"] = o.skinOverClothesTexels;
     report["model_load_seconds"] = o.modelLoadSeconds;
     report["side_ear"] = {{"found", o.sideEar.found}, {"centre_px", {o.sideEar.centre.x, o.sideEar.centre.y}},
                           {"score", o.sideEar.score}, {"scale", o.sideEar.scale},

@@ -24,6 +24,11 @@ namespace {
 // Under big hair, how far outside the shaped head an outline crossing on hair may lie and still count: about what
 // short hair adds to the skull's outline.
 constexpr double kBigHairOutlineSlackMm = 15.0;
+// Clothes are repainted with skin from this far under the chin down (NeckClothes::topY), fading in above it: the
+// throat under the chin is in shadow, and a beard grows there.
+constexpr double kNeckClothesUnderChinMm = 25.0;
+// ... and behind the ears from this far under the ear's middle, under the lobe.
+constexpr double kNeckClothesUnderEarMm = 40.0;
 
 using Clock = std::chrono::steady_clock;
 
@@ -245,6 +250,20 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
             sides.frontOfZ = (out.fit.earsPlaced ? out.fit.earMiddleMm.z : 0.0) + 15.0;
             out.skinOverHairTexels = skinOverHairBesideFace(texture, out.fit.mesh, out.fit, ColourMatchMasks{m.frontHair, m.sideHair},
                                                             sides, settings_.texture, *textureTables_);
+        }
+        if (out.hair.skinLab[0] > 0.0) {  // the hair analysis measured the skin (none known when it failed)
+            // Clothes round the bottom of the neck (a hood, a collar): the bust's neck shows skin there.
+            NeckClothes neck;
+            neck.skinLab = out.hair.skinLab;
+            neck.topY = out.fit.mesh.positions[base_.frontFeatures.at(landmarkName(8))].y - kNeckClothesUnderChinMm;
+            // Behind the ears, from under the lobes (the head's origin lies between the ear holes).
+            const glm::dvec3 ear = out.fit.earsPlaced ? out.fit.earMiddleMm : glm::dvec3(0.0);
+            neck.backTopY = ear.y - kNeckClothesUnderEarMm;
+            neck.frontZ = ear.z + kNeckClothesUnderEarMm;
+            neck.backZ = ear.z - 0.5 * kNeckClothesUnderEarMm;
+            neck.keepHairBehind = isBigHair(out.hair.style);
+            out.skinOverClothesTexels = skinOverClothesOnNeck(texture, out.fit.mesh, out.fit, ColourMatchMasks{m.frontHair, m.sideHair},
+                                                              neck, settings_.texture, *textureTables_);
         }
         return texture;
     });

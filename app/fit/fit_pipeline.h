@@ -63,6 +63,8 @@ struct FitOutcome {
     SideEyeSpot sideEye;  // where the side photo shows the near eye (fit/face/side_eye.h)
     // Texels of the face's sides where the front photo's hair was repainted with skin (skinOverHairBesideFace).
     int skinOverHairTexels = 0;
+    // Texels round the bottom of the neck where the photos' clothes were repainted with skin (skinOverClothesOnNeck).
+    int skinOverClothesTexels = 0;
     HairEstimate hair;  // the hair style, its colour, beard and moustache (fit/face/hair_analysis.h)
     // With a bob: how far over the brows the front photo shows the forehead, which the bob's fringe leaves clear
     // (fit/parts/hair_part.h foreheadShownMm); 0 otherwise.

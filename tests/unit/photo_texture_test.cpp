@@ -548,6 +548,45 @@ TEST(PhotoTexture, HairOverTheCheekInTheSidePhotoIsRepaintedWithSkin) {
     EXPECT_TRUE(nearColour(square.at(t, 40.0, 75.0), kBlue)) << "above the brows it stays";
 }
 
+// A hood (yellow) round the bottom of the neck in the side photo, rising behind the ear as a hood does at the nape,
+// is repainted with the skin round it; skin in shadow (darker, the same hue) is skin and keeps its own colour; hair
+// (marked) under the neck's top stays, and so does what is not skin above the neck's top (a blue mark).
+TEST(PhotoTexture, ClothesOnTheNeckAreRepaintedWithSkin) {
+    SideSquare square;
+    const cv::Vec3b skin(120, 150, 205), shadow(75, 95, 130), hood(30, 200, 230), hairColour(25, 25, 30);
+    const auto hairAt = [](glm::dvec2 p) { return p.x < -75.0; };  // p: (z, y)
+    const auto paint = [&](glm::dvec2 p) {
+        if (hairAt(p)) return hairColour;
+        if (p.y < (p.x > 0.0 ? -60.0 : -10.0)) return hood;
+        if (p.x > 50.0 && p.x < 70.0 && p.y < -40.0) return shadow;
+        if (p.x > 40.0 && p.x < 70.0 && p.y > 40.0 && p.y < 70.0) return kBlue;
+        return skin;
+    };
+    const cv::Mat side = paintPhoto(square.fit, true, paint);
+    cv::Mat sideHair(400, 400, CV_8U);
+    for (int v = 0; v < 400; ++v)
+        for (int u = 0; u < 400; ++u) sideHair.at<unsigned char>(v, u) = hairAt(square.fit.side.toHead(cv::Point2d(u, v))) ? 255 : 0;
+    const TextureTables tables(square.mesh, square.options);
+    PhotoTexture t = textureFromPhotos(square.mesh, square.fit, square.front, square.all, side, square.all, square.options, tables);
+    ASSERT_TRUE(nearColour(square.at(t, 40.0, -80.0), hood)) << "the photo's hood, before";
+    ASSERT_TRUE(nearColour(square.at(t, -40.0, -30.0), hood)) << "the photo's hood behind the ear, before";
+
+    NeckClothes neck;
+    neck.topY = -30.0;
+    neck.frontZ = 20.0;
+    neck.backZ = -20.0;
+    neck.backTopY = 10.0;
+    cv::Mat lab;
+    cv::cvtColor(cv::Mat(1, 1, CV_32FC3, cv::Scalar(skin[0] / 255.0, skin[1] / 255.0, skin[2] / 255.0)), lab, cv::COLOR_BGR2Lab);
+    neck.skinLab = lab.at<cv::Vec3f>(0, 0);
+    EXPECT_GT(skinOverClothesOnNeck(t, square.mesh, square.fit, ColourMatchMasks{{}, sideHair}, neck, square.options, tables), 0);
+    for (const double z : {20.0, 40.0}) EXPECT_TRUE(nearColour(square.at(t, z, -80.0), skin)) << "skin at " << z << ", -80";
+    for (const double z : {-60.0, -40.0}) EXPECT_TRUE(nearColour(square.at(t, z, -30.0), skin)) << "skin at " << z << ", -30, behind the ear";
+    EXPECT_TRUE(nearColour(square.at(t, 60.0, -50.0), shadow)) << "skin in shadow keeps its colour";
+    EXPECT_TRUE(nearColour(square.at(t, -90.0, -30.0), hairColour)) << "hair stays";
+    EXPECT_TRUE(nearColour(square.at(t, 55.0, 55.0), kBlue)) << "above the neck's top it stays";
+}
+
 // No photo sees the back of the sphere: it is filled from the colours around it, not left black.
 TEST(PhotoTexture, UnseenTexelsAreFilledWithSurroundingColours) {
     const Mesh sphere = uvSphere(kRadius);

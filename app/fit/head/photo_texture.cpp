@@ -671,62 +671,116 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     return out;
 }
 
-int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const ColourMatchMasks& notSkin,
-                           const FaceSides& sides, const PhotoTextureOptions& options, const TextureTables& tables) {
-    if (notSkin.frontNotSkin.empty() && notSkin.sideNotSkin.empty()) return 0;
+namespace {
+
+// A texel as a repaint sees it: the point of the head and, when it took a photo (`seen`), which and where in it
+// (pixel(), worked out only when asked: most texels of a repaint are decided by where they lie).
+struct PhotoTexel {
+    glm::dvec3 head;
+    bool seen = false, front = false;
+    const HeadFit* fit = nullptr;
+    const PhotoTextureOptions* options = nullptr;
+    cv::Point2d pixel() const { return front ? fit->front.toPixel({head.x, head.y}) : sidePhotoPoint(*fit, *options, head); }
+};
+// What such a texel is to a repaint: a source of the skin's colour, or repainted by `repaint` (0..1), or neither.
+struct TexelRole {
+    bool skin = false;
+    float repaint = 0.0f;
+};
+
+// The part of the texture a repaint looks at: the triangles that may matter to it and the texels' box round them
+// (the fill and the feather reach 8 texels past it), so that a repaint of the neck does not visit the whole head.
+struct RepaintArea {
+    std::vector<unsigned char> triangles;  // per triangle of the mesh, 1 where it matters
+    cv::Rect box;                          // texels
+};
+
+// The triangles of which any corner `near(position)` says matters, and their box in the texture.
+template <typename Near>
+RepaintArea repaintArea(const Mesh& fitted, cv::Size size, const Near& near) {
+    RepaintArea area;
+    area.triangles.assign(fitted.triangles.size(), 0);
+    double u0 = 1.0, v0 = 1.0, u1 = 0.0, v1 = 0.0;
+    for (std::size_t i = 0; i < fitted.triangles.size(); ++i) {
+        const glm::uvec3& t = fitted.triangles[i];
+        if (!near(fitted.positions[t.x]) && !near(fitted.positions[t.y]) && !near(fitted.positions[t.z])) continue;
+        area.triangles[i] = 1;
+        for (const std::uint32_t k : {t.x, t.y, t.z}) {
+            u0 = std::min(u0, fitted.uvs[k].x), u1 = std::max(u1, fitted.uvs[k].x);
+            v0 = std::min(v0, fitted.uvs[k].y), v1 = std::max(v1, fitted.uvs[k].y);
+        }
+    }
+    if (u1 < u0) return area;
+    // Aligned to the fill's quarter resolution, with room for the feather.
+    constexpr int margin = 8;
+    const int x0 = std::max(0, (static_cast<int>(u0 * size.width) - margin) / 4 * 4);
+    const int y0 = std::max(0, (static_cast<int>(v0 * size.height) - margin) / 4 * 4);
+    const int x1 = std::min(size.width, static_cast<int>(std::ceil(u1 * size.width)) + margin);
+    const int y1 = std::min(size.height, static_cast<int>(std::ceil(v1 * size.height)) + margin);
+    area.box = cv::Rect(x0, y0, x1 - x0, y1 - y0);
+    return area;
+}
+
+// Repaints the texels `role` says with the skin round them: continued by pull-push from the texels it calls skin
+// (only texels that took a photo are skin), with the skin layer's fine detail (tables.skinDetail), feathered at the
+// edge. Only the area's triangles are asked. `role(texel, x, y)` must be safe to call from several threads. Returns
+// how many texels were repainted at half weight or more.
+template <typename Role>
+int repaintWithSkin(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const PhotoTextureOptions& options,
+                    const TextureTables& tables, const RepaintArea& area, const Role& role) {
     if (texture.texture.size() != tables.full().size || !tables.fits(fitted))
         throw BoothError(ErrorKind::Internal, "", "texture: the texel tables were made for another mesh or size");
     const TexelMap& map = tables.full();
-    const cv::Size size = map.size;
-    // How much a point is on the face's sides: 1 inside, fading out above, behind and under them.
-    const auto fadeOut = [&](double beyond) {
-        if (beyond <= 0.0) return 1.0;
-        return sides.fadeMm > 0.0 ? 1.0 - smoothstep(beyond / sides.fadeMm) : 0.0;
-    };
-    const auto onSides = [&](const glm::dvec3& p) {
-        if (std::abs(p.x) < sides.innerX) return 0.0;
-        return fadeOut(p.y - sides.topY) * fadeOut(sides.bottomY - p.y) * fadeOut(sides.frontOfZ - p.z);
-    };
-    // Each texel that took a photo: skin (a source of the fill) or hair on the face's sides (repainted, by how much).
-    cv::Mat colour(size, CV_32FC3, cv::Scalar::all(0)), weight(size, CV_32F, cv::Scalar(0));
-    cv::Mat target(size, CV_32F, cv::Scalar(0));
-    cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
-        for (int y = rows.start; y < rows.end; ++y) {
-            const int* tri = map.triangle.ptr<int>(y);
-            const unsigned char* src = texture.source.ptr<unsigned char>(y);
-            const cv::Vec3b* in = texture.texture.ptr<cv::Vec3b>(y);
+    const cv::Rect box = area.box & cv::Rect(cv::Point(0, 0), map.size);
+    if (box.empty()) return 0;
+    const cv::Size size = box.size();
+    // The fill runs at a quarter of the resolution (the skin's colour varies slowly; its detail is added at full
+    // resolution): each cell of 4 x 4 texels sums its skin texels' colours and its repaint weights (one thread a row
+    // of cells, so that no two write the same cell).
+    const cv::Size small((size.width + 3) / 4, (size.height + 3) / 4);
+    cv::Mat smallColour(small, CV_32FC3, cv::Scalar::all(0)), smallWeight(small, CV_32F, cv::Scalar(0));
+    cv::Mat smallTarget(small, CV_32F, cv::Scalar(0)), target(size, CV_32F, cv::Scalar(0));
+    cv::parallel_for_(cv::Range(0, small.height), [&](const cv::Range& cells) {
+        for (int y = cells.start * 4; y < std::min(size.height, cells.end * 4); ++y) {
+            const int ty = box.y + y;
+            const int* tri = map.triangle.ptr<int>(ty) + box.x;
+            const unsigned char* src = texture.source.ptr<unsigned char>(ty) + box.x;
+            const cv::Vec3b* in = texture.texture.ptr<cv::Vec3b>(ty) + box.x;
+            cv::Vec3f* cellColour = smallColour.ptr<cv::Vec3f>(y / 4);
+            float* cellWeight = smallWeight.ptr<float>(y / 4);
+            float* cellTarget = smallTarget.ptr<float>(y / 4);
             for (int x = 0; x < size.width; ++x) {
-                if (tri[x] < 0 || (src[x] != PhotoTexture::Front && src[x] != PhotoTexture::Side)) continue;
+                if (tri[x] < 0 || !area.triangles[static_cast<std::size_t>(tri[x])]) continue;
                 const glm::uvec3& t = fitted.triangles[static_cast<std::size_t>(tri[x])];
-                const cv::Vec2d b = map.barycentric(tri[x], x, y);
-                const glm::dvec3 p = b[0] * fitted.positions[t.x] + b[1] * fitted.positions[t.y] +
-                                     (1.0 - b[0] - b[1]) * fitted.positions[t.z];
-                const bool front = src[x] == PhotoTexture::Front;
-                const cv::Mat& hair = front ? notSkin.frontNotSkin : notSkin.sideNotSkin;
-                const cv::Point2d px = front ? fit.front.toPixel({p.x, p.y}) : sidePhotoPoint(fit, options, p);
-                if (isSkin(hair, static_cast<float>(px.x), static_cast<float>(px.y))) {
-                    colour.at<cv::Vec3f>(y, x) = cv::Vec3f(in[x][0], in[x][1], in[x][2]);
-                    weight.at<float>(y, x) = 1.0f;
-                } else {
-                    target.at<float>(y, x) = static_cast<float>(onSides(p));
+                const cv::Vec2d b = map.barycentric(tri[x], box.x + x, ty);
+                PhotoTexel texel;
+                texel.head = b[0] * fitted.positions[t.x] + b[1] * fitted.positions[t.y] + (1.0 - b[0] - b[1]) * fitted.positions[t.z];
+                texel.seen = src[x] == PhotoTexture::Front || src[x] == PhotoTexture::Side;
+                texel.front = src[x] == PhotoTexture::Front;
+                texel.fit = &fit;
+                texel.options = &options;
+                const TexelRole r = role(texel, box.x + x, ty);
+                if (r.skin && texel.seen) {
+                    cellColour[x / 4] += cv::Vec3f(in[x][0], in[x][1], in[x][2]);
+                    cellWeight[x / 4] += 1.0f;
+                } else if (r.repaint > 0.0f) {
+                    target.at<float>(y, x) = r.repaint;
+                    cellTarget[x / 4] += r.repaint / 16.0f;
                 }
             }
         }
     });
     const int repainted = cv::countNonZero(target >= 0.5f);
-    if (cv::countNonZero(target > 0.0f) == 0 || cv::countNonZero(weight) == 0) return 0;
-    // The fill at a quarter of the resolution (the skin's colour varies slowly; its detail is added at full
-    // resolution), and the edge feathered over a few texels there, so that no hard edge is left where the photo's
-    // hair ended.
-    cv::Mat smallColour, smallWeight, smallTarget;
-    const cv::Size small((size.width + 3) / 4, (size.height + 3) / 4);
-    cv::resize(colour, smallColour, small, 0, 0, cv::INTER_AREA);
-    cv::resize(weight, smallWeight, small, 0, 0, cv::INTER_AREA);
+    if (cv::countNonZero(smallTarget) == 0 || cv::countNonZero(smallWeight) == 0) return 0;
     for (int y = 0; y < small.height; ++y)
         for (int x = 0; x < small.width; ++x)
-            if (const float w = smallWeight.at<float>(y, x); w > 0.0f) smallColour.at<cv::Vec3f>(y, x) /= w;
+            if (float& w = smallWeight.at<float>(y, x); w > 0.0f) {
+                smallColour.at<cv::Vec3f>(y, x) /= w;
+                w /= 16.0f;
+            }
     pullPushFill(smallColour, smallWeight);
-    cv::resize(target, smallTarget, small, 0, 0, cv::INTER_AREA);
+    // The edge feathered over a few texels at that resolution, so that no hard edge is left where the photo's hair
+    // or clothes ended.
     cv::GaussianBlur(smallTarget, smallTarget, cv::Size(), 1.0);
     // Both read at full resolution, bilinearly, and only where the feathered edge reaches.
     const auto mix = [&](const cv::Mat& m, auto zero, int x, int y) {
@@ -739,24 +793,100 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
         return V((1.0f - ay) * ((1.0f - ax) * m.at<V>(y0, x0) + ax * m.at<V>(y0, x1)) +
                  ay * ((1.0f - ax) * m.at<V>(y1, x0) + ax * m.at<V>(y1, x1)));
     };
+    // The cells the feathered edge reaches (a texel reads the 2 x 2 cells round it).
+    cv::Mat reached;
+    cv::dilate(smallTarget > 0.0f, reached, cv::Mat::ones(3, 3, CV_8U));
     const cv::Mat& detail = tables.skinDetail();
-    for (int y = 0; y < size.height; ++y) {
-        const int* tri = map.triangle.ptr<int>(y);
-        const float* t = target.ptr<float>(y);
-        cv::Vec3b* o = texture.texture.ptr<cv::Vec3b>(y);
-        for (int x = 0; x < size.width; ++x) {
-            if (tri[x] < 0) continue;
-            const float wx = std::max(t[x], mix(smallTarget, 0.0f, x, y));
-            if (wx <= 0.0f) continue;
-            cv::Vec3f skin = mix(smallColour, cv::Vec3f(), x, y);
-            if (!detail.empty()) {
-                const cv::Vec<schar, 3> d = detail.at<cv::Vec<schar, 3>>(y, x);
-                skin += cv::Vec3f(d[0], d[1], d[2]);
+    cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
+        for (int y = rows.start; y < rows.end; ++y) {
+            const int ty = box.y + y;
+            const int* tri = map.triangle.ptr<int>(ty) + box.x;
+            const float* t = target.ptr<float>(y);
+            const unsigned char* near = reached.ptr<unsigned char>(y / 4);
+            cv::Vec3b* o = texture.texture.ptr<cv::Vec3b>(ty) + box.x;
+            for (int x = 0; x < size.width; ++x) {
+                if (tri[x] < 0 || !near[x / 4]) continue;
+                const float wx = std::max(t[x], mix(smallTarget, 0.0f, x, y));
+                if (wx <= 0.0f) continue;
+                cv::Vec3f skin = mix(smallColour, cv::Vec3f(), x, y);
+                if (!detail.empty()) {
+                    const cv::Vec<schar, 3> d = detail.at<cv::Vec<schar, 3>>(ty, box.x + x);
+                    skin += cv::Vec3f(d[0], d[1], d[2]);
+                }
+                for (int c = 0; c < 3; ++c) o[x][c] = cv::saturate_cast<unsigned char>(wx * skin[c] + (1.0f - wx) * o[x][c]);
             }
-            for (int c = 0; c < 3; ++c) o[x][c] = cv::saturate_cast<unsigned char>(wx * skin[c] + (1.0f - wx) * o[x][c]);
         }
-    }
+    });
     return repainted;
+}
+
+// How far past a repaint's region the texels of skin are sources of its fill (mm).
+constexpr double kSkinAroundMm = 40.0;
+
+// 1 up to the edge, fading out (smoothly) over `fadeMm` beyond it (`beyond`: how far past the edge, in mm).
+double fadeOutPast(double beyond, double fadeMm) {
+    if (beyond <= 0.0) return 1.0;
+    return fadeMm > 0.0 ? 1.0 - smoothstep(beyond / fadeMm) : 0.0;
+}
+
+}  // namespace
+
+int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const ColourMatchMasks& notSkin,
+                           const FaceSides& sides, const PhotoTextureOptions& options, const TextureTables& tables) {
+    if (notSkin.frontNotSkin.empty() && notSkin.sideNotSkin.empty()) return 0;
+    // How much a point is on the face's sides: 1 inside, fading out above, behind and under them.
+    const auto onSides = [&](const glm::dvec3& p) {
+        if (std::abs(p.x) < sides.innerX) return 0.0;
+        return fadeOutPast(p.y - sides.topY, sides.fadeMm) * fadeOutPast(sides.bottomY - p.y, sides.fadeMm) *
+               fadeOutPast(sides.frontOfZ - p.z, sides.fadeMm);
+    };
+    // The face's height and a little more: the sides and the skin round them the fill continues.
+    const RepaintArea area = repaintArea(fitted, texture.texture.size(), [&](const glm::dvec3& p) {
+        return p.y > sides.bottomY - sides.fadeMm - kSkinAroundMm && p.y < sides.topY + sides.fadeMm + kSkinAroundMm;
+    });
+    // Each texel that took a photo: skin (a source of the fill) or hair on the face's sides (repainted, by how much).
+    return repaintWithSkin(texture, fitted, fit, options, tables, area, [&](const PhotoTexel& t, int, int) {
+        if (!t.seen) return TexelRole{};
+        const cv::Mat& hair = t.front ? notSkin.frontNotSkin : notSkin.sideNotSkin;
+        const cv::Point2d px = t.pixel();
+        if (isSkin(hair, static_cast<float>(px.x), static_cast<float>(px.y))) return TexelRole{true, 0.0f};
+        return TexelRole{false, static_cast<float>(onSides(t.head))};
+    });
+}
+
+int skinOverClothesOnNeck(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const ColourMatchMasks& hair,
+                          const NeckClothes& neck, const PhotoTextureOptions& options, const TextureTables& tables) {
+    if (texture.texture.empty()) return 0;
+    const auto topAt = [&](double z) {
+        const double behind = neck.frontZ > neck.backZ ? smoothstep(std::clamp((neck.frontZ - z) / (neck.frontZ - neck.backZ), 0.0, 1.0)) : 0.0;
+        return std::pair{neck.topY + behind * (neck.backTopY - neck.topY), behind};
+    };
+    // The neck and the skin above it the fill continues.
+    const RepaintArea area = repaintArea(fitted, texture.texture.size(), [&](const glm::dvec3& p) {
+        return p.y < topAt(p.z).first + neck.fadeMm + kSkinAroundMm;
+    });
+    if (area.box.empty()) return 0;
+    // The texture's colours in CIE L*a*b* (8-bit: L 0..255, a and b offset by 128), against the visitor's skin.
+    cv::Mat lab;
+    cv::cvtColor(texture.texture(area.box), lab, cv::COLOR_BGR2Lab);
+    const auto skinDistance = [&](int x, int y) {
+        const cv::Vec3b c = lab.at<cv::Vec3b>(y - area.box.y, x - area.box.x);
+        const double dl = neck.lightnessWeight * (c[0] * 100.0 / 255.0 - neck.skinLab[0]);
+        const double da = c[1] - 128.0 - neck.skinLab[1], db = c[2] - 128.0 - neck.skinLab[2];
+        return std::sqrt(dl * dl + da * da + db * db);
+    };
+    return repaintWithSkin(texture, fitted, fit, options, tables, area, [&](const PhotoTexel& t, int x, int y) {
+        const auto [top, behind] = topAt(t.head.z);
+        const bool under = t.head.y < top + neck.fadeMm;
+        if (t.head.y > top + neck.fadeMm + kSkinAroundMm || (!under && !t.seen)) return TexelRole{};
+        if (t.seen && (!under || neck.keepHairBehind || behind < 0.5)) {
+            const cv::Mat& h = t.front ? hair.frontNotSkin : hair.sideNotSkin;
+            const cv::Point2d px = t.pixel();
+            if (!isSkin(h, static_cast<float>(px.x), static_cast<float>(px.y))) return TexelRole{};  // hair stays
+        }
+        if (skinDistance(x, y) <= neck.maxSkinDistance) return TexelRole{t.seen, 0.0f};
+        return TexelRole{false, under ? static_cast<float>(fadeOutPast(t.head.y - top, neck.fadeMm)) : 0.0f};
+    });
 }
 
 void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& detail) {

@@ -142,6 +142,29 @@ struct FaceSides {
 int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const ColourMatchMasks& notSkin,
                            const FaceSides& sides, const PhotoTextureOptions& options, const TextureTables& tables);
 
+// Clothes the photos show where the bust has its neck: a hood, a collar or a shirt's neckline round the bottom of
+// the neck (FRMDB 002's yellow hood and 003's black T-shirt were painted on the back of their necks, where the side
+// photo shows them). Under the neck's top (head space, mm: topY ahead of frontZ, under the chin; backTopY behind
+// backZ, under the ears, where a hood rises to the nape; smoothly between) and fading in over fadeMm above it, the
+// texels that took a photo where it shows neither hair (`hair`: each photo's hair pixels, empty: none known) nor a
+// colour near the skin's (skinLab: CIE L*a*b*, the hair analysis' skin; lightness at lightnessWeight, as shading moves
+// it far more than the chroma) are repainted with the skin round them (the texels near the skin's colour); so are the
+// texels no photo saw there that the fill continued in such a colour. keepHairBehind false (short hair, none): what
+// the hair pixels show behind the ears under the neck's top is not hair that hangs there but a dark collar
+// (FRMDB 003's black T-shirt), and is repainted too.
+struct NeckClothes {
+    double topY = 0.0, frontZ = 0.0;
+    double backTopY = 0.0, backZ = 0.0;
+    double fadeMm = 15.0;
+    bool keepHairBehind = true;
+    cv::Vec3d skinLab{0.0, 0.0, 0.0};
+    double lightnessWeight = 0.5;
+    double maxSkinDistance = 20.0;
+};
+// Returns how many texels were repainted (at half weight or more).
+int skinOverClothesOnNeck(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fit, const ColourMatchMasks& hair,
+                          const NeckClothes& neck, const PhotoTextureOptions& options, const TextureTables& tables);
+
 // Where no photo saw the head (texels the fill made up: under the chin, in and behind the ears, parts of the top),
 // the base head's skin layer lends its detail (TextureTables::skinDetail, added by textureFromPhotos), so that ears,
 // creases and lips keep their shading while the colour stays the one the fill continued from the photos (hair where
