@@ -739,7 +739,8 @@ int repaintWithSkin(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fi
     // of cells, so that no two write the same cell).
     const cv::Size small((size.width + 3) / 4, (size.height + 3) / 4);
     cv::Mat smallColour(small, CV_32FC3, cv::Scalar::all(0)), smallWeight(small, CV_32F, cv::Scalar(0));
-    cv::Mat smallTarget(small, CV_32F, cv::Scalar(0)), target(size, CV_32F, cv::Scalar(0));
+    cv::Mat smallTarget(small, CV_32F, cv::Scalar(0)), smallTargetMax(small, CV_32F, cv::Scalar(0));
+    cv::Mat target(size, CV_32F, cv::Scalar(0));
     cv::parallel_for_(cv::Range(0, small.height), [&](const cv::Range& cells) {
         for (int y = cells.start * 4; y < std::min(size.height, cells.end * 4); ++y) {
             const int ty = box.y + y;
@@ -749,6 +750,7 @@ int repaintWithSkin(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fi
             cv::Vec3f* cellColour = smallColour.ptr<cv::Vec3f>(y / 4);
             float* cellWeight = smallWeight.ptr<float>(y / 4);
             float* cellTarget = smallTarget.ptr<float>(y / 4);
+            float* cellTargetMax = smallTargetMax.ptr<float>(y / 4);
             for (int x = 0; x < size.width; ++x) {
                 if (tri[x] < 0 || !area.triangles[static_cast<std::size_t>(tri[x])]) continue;
                 const glm::uvec3& t = fitted.triangles[static_cast<std::size_t>(tri[x])];
@@ -766,6 +768,7 @@ int repaintWithSkin(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fi
                 } else if (r.repaint > 0.0f) {
                     target.at<float>(y, x) = r.repaint;
                     cellTarget[x / 4] += r.repaint / 16.0f;
+                    cellTargetMax[x / 4] = std::max(cellTargetMax[x / 4], r.repaint);
                 }
             }
         }
@@ -793,9 +796,11 @@ int repaintWithSkin(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fi
         return V((1.0f - ay) * ((1.0f - ax) * m.at<V>(y0, x0) + ax * m.at<V>(y0, x1)) +
                  ay * ((1.0f - ax) * m.at<V>(y1, x0) + ax * m.at<V>(y1, x1)));
     };
-    // The cells the feathered edge reaches (a texel reads the 2 x 2 cells round it).
-    cv::Mat reached;
+    // The cells the feathered edge reaches (a texel reads the 2 x 2 cells round it), and the most a texel in the
+    // cells round each was repainted by.
+    cv::Mat reached, edgeMax;
     cv::dilate(smallTarget > 0.0f, reached, cv::Mat::ones(3, 3, CV_8U));
+    cv::dilate(smallTargetMax, edgeMax, cv::Mat::ones(3, 3, CV_8U));
     const cv::Mat& detail = tables.skinDetail();
     cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
         for (int y = rows.start; y < rows.end; ++y) {
@@ -803,10 +808,14 @@ int repaintWithSkin(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fi
             const int* tri = map.triangle.ptr<int>(ty) + box.x;
             const float* t = target.ptr<float>(y);
             const unsigned char* near = reached.ptr<unsigned char>(y / 4);
+            const float* edge = edgeMax.ptr<float>(y / 4);
             cv::Vec3b* o = texture.texture.ptr<cv::Vec3b>(ty) + box.x;
             for (int x = 0; x < size.width; ++x) {
-                if (tri[x] < 0 || !near[x / 4]) continue;
-                const float wx = std::max(t[x], mix(smallTarget, 0.0f, x, y));
+                if (!near[x / 4]) continue;
+                // Texels between the UV islands (no triangle) hold the fill's bleed of the colours beside them, which
+                // the renderer's filtering reads at the islands' edges: they take the most any texel round them
+                // was repainted by, so that no rim of the old colour is left round what was.
+                const float wx = tri[x] >= 0 ? std::max(t[x], mix(smallTarget, 0.0f, x, y)) : edge[x / 4];
                 if (wx <= 0.0f) continue;
                 cv::Vec3f skin = mix(smallColour, cv::Vec3f(), x, y);
                 if (!detail.empty()) {
