@@ -82,6 +82,15 @@ cv::Mat paintPhoto(const HeadFit& fit, bool side, const std::function<cv::Vec3b(
     return photo;
 }
 
+// A photo's mask (255 where `inside` holds for the pixel's plane coordinates in mm), as the hair analysis gives.
+cv::Mat paintMask(const HeadFit& fit, bool side, const std::function<bool(glm::dvec2)>& inside) {
+    cv::Mat mask(400, 400, CV_8U);
+    for (int v = 0; v < mask.rows; ++v)
+        for (int u = 0; u < mask.cols; ++u)
+            mask.at<unsigned char>(v, u) = inside((side ? fit.side : fit.front).toHead(cv::Point2d(u, v))) ? 255 : 0;
+    return mask;
+}
+
 cv::Vec3d meanWhere(const cv::Mat& image, const cv::Mat& mask) {
     const cv::Scalar m = cv::mean(image, mask);
     return {m[0], m[1], m[2]};
@@ -492,9 +501,7 @@ TEST(PhotoTexture, HairBesideTheFaceIsRepaintedWithSkin) {
     const HeadFit fit = photoFrames();
     const auto hairAt = [](glm::dvec2 p) { return std::abs(p.x) > 60.0 || std::abs(p.x) < 10.0; };
     const cv::Mat front = paintPhoto(fit, false, [&](glm::dvec2 p) { return hairAt(p) ? kBlue : kGreen; });
-    cv::Mat frontHair(400, 400, CV_8U);
-    for (int v = 0; v < 400; ++v)
-        for (int u = 0; u < 400; ++u) frontHair.at<unsigned char>(v, u) = hairAt(fit.front.toHead(cv::Point2d(u, v))) ? 255 : 0;
+    const cv::Mat frontHair = paintMask(fit, false, hairAt);
     const cv::Mat side(400, 400, CV_8UC3, cv::Scalar(kRed));
     const cv::Mat all(400, 400, CV_8U, cv::Scalar(255));
     PhotoTextureOptions o;
@@ -532,9 +539,7 @@ TEST(PhotoTexture, HairOverTheCheekInTheSidePhotoIsRepaintedWithSkin) {
     SideSquare square;
     const auto hairAt = [](glm::dvec2 p) { return (p.x > 20.0 && p.x < 60.0) || p.x < -20.0; };  // p: (z, y)
     const cv::Mat side = paintPhoto(square.fit, true, [&](glm::dvec2 p) { return hairAt(p) ? kBlue : kGreen; });
-    cv::Mat sideHair(400, 400, CV_8U);
-    for (int v = 0; v < 400; ++v)
-        for (int u = 0; u < 400; ++u) sideHair.at<unsigned char>(v, u) = hairAt(square.fit.side.toHead(cv::Point2d(u, v))) ? 255 : 0;
+    const cv::Mat sideHair = paintMask(square.fit, true, hairAt);
     const TextureTables tables(square.mesh, square.options);
     PhotoTexture t = textureFromPhotos(square.mesh, square.fit, square.front, square.all, side, square.all, square.options, tables);
     ASSERT_TRUE(nearColour(square.at(t, 40.0, 0.0), kBlue)) << "the photo's hair, before";
@@ -565,9 +570,7 @@ TEST(PhotoTexture, ClothesOnTheNeckAreRepaintedWithSkin) {
         return skin;
     };
     const cv::Mat side = paintPhoto(square.fit, true, paint);
-    cv::Mat sideHair(400, 400, CV_8U);
-    for (int v = 0; v < 400; ++v)
-        for (int u = 0; u < 400; ++u) sideHair.at<unsigned char>(v, u) = hairAt(square.fit.side.toHead(cv::Point2d(u, v))) ? 255 : 0;
+    const cv::Mat sideHair = paintMask(square.fit, true, hairAt);
     const TextureTables tables(square.mesh, square.options);
     PhotoTexture t = textureFromPhotos(square.mesh, square.fit, square.front, square.all, side, square.all, square.options, tables);
     ASSERT_TRUE(nearColour(square.at(t, 40.0, -80.0), hood)) << "the photo's hood, before";
