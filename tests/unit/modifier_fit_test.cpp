@@ -125,6 +125,50 @@ TEST(ModifierFit, RegularisationPullsTowardsTheAverage) {
     EXPECT_LT(previous, 0.05);  // at a huge lambda the head stays the average one
 }
 
+// The subject's right and left modifiers of one slider are held together by mirrorRegularisation: one side measured
+// 1.2 mm off (as dlib's scatter puts one eye's points) reads 0.2 of a weight more on that side alone; held together,
+// both sides take the mean of what they measure.
+TEST(ModifierFit, MirroredModifiersAreHeldTogether) {
+    Problem p;
+    for (int i = 0; i < 20; ++i) p.base.emplace_back(-30.0 - i, 0.5 * i, 10.0);  // the subject's right (-x) ...
+    for (int i = 0; i < 20; ++i) p.base.emplace_back(30.0 + i, 0.5 * i, 10.0);   // ... and left
+    for (int i = 0; i < 20; ++i) p.base.emplace_back(0.0, 0.5 * i, 40.0);        // the midline: the frame's shift
+    p.basis.vertexCount = p.base.size();
+    for (const char* side : {"r", "l"}) {
+        Modifier m;
+        m.name = std::string("eyes/") + side + "-eye-move-out";
+        m.group = "eyes";
+        for (std::uint32_t v = side[0] == 'r' ? 0 : 20, end = v + 20; v < end; ++v) {
+            m.vertices.push_back(v);
+            m.offsets.emplace_back(side[0] == 'r' ? -6.0f : 6.0f, 0.0f, 0.0f);
+        }
+        p.basis.modifiers.push_back(m);
+    }
+    Modifier unpaired;  // a name with no side is nobody's mirror
+    unpaired.name = "nose/nose-trans-up";
+    p.basis.modifiers.push_back(unpaired);
+    const auto pairs = mirroredModifiers(p.basis);
+    ASSERT_EQ(pairs.size(), 1u);
+    EXPECT_EQ(pairs[0], (std::pair<std::size_t, std::size_t>(0, 1)));
+
+    auto targets = targetsFor(p, {0.5, 0.5, 0.0}, glm::dvec3(1.0), glm::dvec3(0.0), glm::dvec3(0.0));
+    for (ModifierTarget& t : targets)
+        if (t.vertex < 20 && t.view == View::Front) t.target.x -= 1.2;  // 0.2 of the right modifier's 6 mm
+    ModifierFitOptions o;
+    o.regularisation = 1e-9;
+    o.scaleRange = 0.0;
+    o.mirrorRegularisation = 0.0;
+    const ModifierFit apart = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
+    EXPECT_GT(apart.weights[0] - apart.weights[1], 0.15);
+    o.mirrorRegularisation = 1e9;
+    const ModifierFit together = fitModifiers(p.basis, p.base, glm::dvec3(1.0), glm::dvec3(0.0), targets, o);
+    EXPECT_NEAR(together.weights[0], together.weights[1], 1e-6);
+    EXPECT_NEAR(together.weights[0], 0.6, 1e-4);
+    // What the symmetric shape leaves (0.6 mm towards the right on either side) the frame's shift shares with the
+    // midline's 20 exact points: 40 x 0.6 / 60.
+    EXPECT_NEAR(together.translation.x, -0.4, 1e-4);
+}
+
 // An outline target counts along its normal only: moved along the outline (here the front view's y), it still gives
 // the true weights, and the modifier is free to move the vertex along the outline.
 TEST(ModifierFit, OutlineTargetsCountAlongTheirNormalOnly) {

@@ -94,9 +94,11 @@ struct HairOptions {
     double longBeside = 0.1;
     // With clothes of the hair's own colour under the neck (clothesAsHair over clothesAsHair: they fill the windows
     // beside the neck as hair would), long hair also needs downTheBack over longDownTheBack. HairPopulation's long
-    // hair 0.69-0.86 there, its bob 29 (a brown bob over a brown shirt, which read long) 0.15.
+    // hair 0.69-0.86 there (FRMDB 005 0.66), its bob 29 (a brown bob over a brown shirt, which read long) 0.15, and
+    // 0.19-0.20 since the base head's neck edge was smoothed (2026-12-07): the limit sits between the two, not on the
+    // bob's edge.
     double clothesAsHair = 0.5;
-    double longDownTheBack = 0.2;
+    double longDownTheBack = 0.35;
     double beside = 0.2;         // besideFace over this (not long): a bob
     // ... but over tiedBackBeside when the side photo shows hair tied back (a ponytail's windows, below): hair tied
     // low leaves strands and the hair over the ears beside the jaw (FRMDB 004's low knot 0.43), a bob fills it

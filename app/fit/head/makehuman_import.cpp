@@ -38,6 +38,7 @@ constexpr double kMmPerDm = 100.0;
 constexpr std::size_t kMakeHumanVertices = 19158;
 constexpr int kBodyMaterial = 0;
 constexpr int kRightEyeMaterial = 6, kLeftEyeMaterial = 7;
+constexpr int kNeckLoopSmoothing = 10;  // lambda-mu pairs over the neck's lowest loop
 
 // The 68 iBUG landmarks as hm08 vertices: where the booth's own detector (dlib's predictor) finds them on the front
 // renders of the 60 synthetic visitors of tests/data/makehuman_population_data_test.cpp (seeds 1-60): each found
@@ -548,7 +549,11 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
     if (caps.empty()) throw BoothError(ErrorKind::BadConfig, packageDir.string(), "the cut head has no opening at the neck");
     // The neck's opening runs along whole quads, up and down by a row where the cut surface crosses them: a saw edge
     // in every view of the avatar. Its vertices are moved down onto the cut surface (the neck's lowest loop), so the
-    // edge is as smooth as the surface, and the quads of the last row stretch a little.
+    // edge is as smooth as the surface, and the quads of the last row stretch a little. Where the cut rises to the
+    // sides (behind the ears) the loop also steps in and out across the quads by a row (7 mm), and on the rising
+    // surface that made a spike 10 mm high whose cap triangle faced sideways, a light triangle at the back of every
+    // avatar's neck in the 3/4 view: the loop is smoothed across first (Taubin's lambda-mu steps, which do not
+    // shrink it).
     {
         const auto meanY = [&](const Cap& c) {
             double sum = 0.0;
@@ -557,6 +562,21 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
         };
         const Cap& neck = *std::min_element(caps.begin(), caps.end(), [&](const Cap& a, const Cap& b) { return meanY(a) < meanY(b); });
         const std::set<std::uint32_t> onNeckEdge(neck.loop.begin(), neck.loop.end());
+        const std::size_t n = neck.loop.size();
+        for (int step = 0; step < 2 * kNeckLoopSmoothing; ++step) {
+            const double factor = step % 2 == 0 ? 0.5 : -0.53;
+            std::vector<glm::dvec2> moved(n);
+            for (std::size_t i = 0; i < n; ++i) {
+                const glm::dvec3& prev = human[neck.loop[(i + n - 1) % n]];
+                const glm::dvec3& next = human[neck.loop[(i + 1) % n]];
+                const glm::dvec3& p = human[neck.loop[i]];
+                moved[i] = glm::dvec2(p.x, p.z) + factor * (0.5 * glm::dvec2(prev.x + next.x, prev.z + next.z) - glm::dvec2(p.x, p.z));
+            }
+            for (std::size_t i = 0; i < n; ++i) {
+                human[neck.loop[i]].x = moved[i].x;
+                human[neck.loop[i]].z = moved[i].y;
+            }
+        }
         for (const auto v : neck.loop) human[v].y = neckCut(human[v]);
         for (const auto& [key, headVertex] : vertexOf)
             if (onNeckEdge.count(key.first)) mesh.positions[headVertex] = human[key.first] * kMmPerDm;

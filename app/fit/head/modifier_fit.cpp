@@ -100,6 +100,21 @@ void minimiseInBox(const std::vector<double>& N, const std::vector<double>& g, c
 }
 
 
+std::vector<std::pair<std::size_t, std::size_t>> mirroredModifiers(const ModifierBasis& basis) {
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t k = 0; k < basis.modifiers.size(); ++k) {
+        const std::string& name = basis.modifiers[k].name;
+        const auto slash = name.find('/');
+        if (slash == std::string::npos || slash + 2 >= name.size() || name[slash + 1] != 'r' || name[slash + 2] != '-')
+            continue;
+        std::string left = name;
+        left[slash + 1] = 'l';
+        const std::size_t j = basis.find(left);
+        if (j < basis.modifiers.size()) pairs.emplace_back(k, j);
+    }
+    return pairs;
+}
+
 ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec3>& basePositions, const glm::dvec3& scale,
                          const glm::dvec3& centre, const std::vector<ModifierTarget>& targets,
                          const ModifierFitOptions& options) {
@@ -154,6 +169,8 @@ ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec
     lower[K + 3] = -std::max(0.0, options.scaleRange);
     upper[K + 3] = std::max(0.0, options.scaleRange);
     std::vector<double> w(n, 0.0), rowWeight(rows, 1.0);
+    const std::vector<std::pair<std::size_t, std::size_t>> mirrorPairs = mirroredModifiers(basis);
+    const double mu = options.mirrorRegularisation;
     const int solves = options.robustMm > 0.0 ? 1 + options.robustIterations : 1;
     for (int solve = 0; solve < solves; ++solve) {
         if (solve > 0)
@@ -183,6 +200,12 @@ ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec
         for (std::size_t k = 0; k < K; ++k) {
             const auto group = options.groupRegularisation.find(basis.modifiers[k].group);
             N[k * n + k] += group != options.groupRegularisation.end() ? group->second : options.regularisation;
+        }
+        for (const auto& [right, left] : mirrorPairs) {  // mu (w_right - w_left)^2
+            N[right * n + right] += mu;
+            N[left * n + left] += mu;
+            N[right * n + left] -= mu;
+            N[left * n + right] -= mu;
         }
         for (std::size_t i = K; i < n; ++i) N[i * n + i] += 1e-9;
         N[(K + 3) * n + K + 3] += options.scaleRegularisation;

@@ -6,7 +6,8 @@
 // in the side view as (z, y), plus a translation (t_x, t_y, t_z) of the photos' frames against the head (the frames
 // are placed by the eye midpoint and the ear hole of the head before its shape is known); sigma's product with the
 // weights is left out (linearised: a second-order term of a few per cent of a few millimetres). Minimised:
-//   sum over targets |projected vertex - target|^2 + lambda sum_k w_k^2 + lambda_s sigma^2,  0 <= w_k <= 1,
+//   sum over targets |projected vertex - target|^2 + lambda sum_k w_k^2 + lambda_s sigma^2
+//     + mu sum over mirrored pairs (w_right - w_left)^2,  0 <= w_k <= 1,
 //   |sigma| <= scaleRange,
 // (for an outline target, the error's parts along its normal and along the outline, each with its weight),
 // so w = 0 (the average head) is what the photos must argue the head away from.
@@ -17,6 +18,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace avatarbooth {
@@ -49,6 +51,11 @@ struct ModifierFitOptions {
     // Modifier groups held at 0: the ears, which no photo measurement sees (the outline rays pass above and below
     // them), would otherwise be bent to fit rays that meet hair.
     std::vector<std::string> fixedGroups = {"ears"};
+    // The subject's right and left modifiers of one slider ("eyes/r-eye-push1-in" and "eyes/l-eye-push1-in", the
+    // cheeks') cost mirrorRegularisation * (w_right - w_left)^2 (square millimetres) apart: faces are nearly
+    // symmetric, and each eye or cheek alone follows dlib's scatter on its own side (README, "How near the fit
+    // comes", has the figures; 100 and up gave the same).
+    double mirrorRegularisation = 1000.0;
     // The head's size, as one more unknown: a uniform change sigma of the given scaling about its centre,
     // within +-scaleRange, costing scaleRegularisation * sigma^2 (square millimetres). The scaling the head fit starts
     // from is one width (dlib's jaw points 0 and 16, a few pixels off on a photo, and wider or narrower against the
@@ -71,6 +78,9 @@ struct ModifierFit {
 ModifierFit fitModifiers(const ModifierBasis& basis, const std::vector<glm::dvec3>& basePositions, const glm::dvec3& scale,
                          const glm::dvec3& centre, const std::vector<ModifierTarget>& targets,
                          const ModifierFitOptions& options = {});
+
+// The basis's mirrored pairs (right, left) by name: "group/r-..." and "group/l-...".
+std::vector<std::pair<std::size_t, std::size_t>> mirroredModifiers(const ModifierBasis& basis);
 
 // The solver underneath, for any small bounded quadratic problem (the character's sliders use it too): minimises
 // 1/2 x^T N x - g^T x over lo <= x <= hi (N dense, n x n row-major, symmetric positive definite; lo == hi holds a
