@@ -6,6 +6,7 @@
 #include "common/image_io.h"
 #include "common/landmark_names.h"
 #include "fit/face/profile.h"
+#include "fit/head/modifier_basis.h"
 #include "fit/head/surface_texels.h"
 #include "fit/parts/hair_part.h"
 
@@ -35,21 +36,11 @@ const T& pick(Rng& rng, const std::vector<T>& items) {
     return items[std::uniform_int_distribution<std::size_t>(0, items.size() - 1)(rng)];
 }
 
-// "eyes/r-eye-bag-min" <-> "eyes/l-eye-bag-min"; a name without a side is its own mirror.
-std::string mirrored(const std::string& name) {
-    const auto slash = name.find('/');
-    if (slash == std::string::npos || slash + 2 >= name.size() || name[slash + 2] != '-') return name;
-    std::string m = name;
-    if (name[slash + 1] == 'r') m[slash + 1] = 'l';
-    else if (name[slash + 1] == 'l') m[slash + 1] = 'r';
-    return m;
-}
-
 // A slider's modifiers share the name up to the last '-' ("nose/nose-trans-vert" for "-up" and "-down"; the head
 // shapes "head/head-oval", "head/head-round", ... count as one slider), and the subject's left and right count as
 // one (the right's name stands for both).
 std::string sliderOf(const std::string& name) {
-    std::string n = mirrored(name) < name ? mirrored(name) : name;
+    std::string n = mirroredModifierName(name) < name ? mirroredModifierName(name) : name;
     const auto dash = n.rfind('-');
     return dash == std::string::npos ? n : n.substr(0, dash);
 }
@@ -177,7 +168,7 @@ std::pair<MakeHumanPerson, Look> draw(const ModifierBasis& basis, unsigned seed)
             const std::string name = pick(rng, ends);
             const double w = uniform(rng, lo, hi);
             set(name, w);
-            if (mirrored(name) != name) set(mirrored(name), w * uniform(rng, 0.9, 1.1));
+            if (mirroredModifierName(name) != name) set(mirroredModifierName(name), w * uniform(rng, 0.9, 1.1));
         }
     };
     drawSliders(face, 8, 0.2, 0.65);

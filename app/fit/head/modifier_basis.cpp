@@ -80,6 +80,15 @@ std::vector<glm::dvec3> ModifierBasis::apply(const std::vector<glm::dvec3>& base
     return out;
 }
 
+std::string mirroredModifierName(const std::string& name) {
+    const auto slash = name.find('/');
+    if (slash == std::string::npos || slash + 2 >= name.size() || name[slash + 2] != '-') return name;
+    std::string m = name;
+    if (name[slash + 1] == 'r') m[slash + 1] = 'l';
+    else if (name[slash + 1] == 'l') m[slash + 1] = 'r';
+    return m;
+}
+
 std::size_t ModifierBasis::find(const std::string& name) const {
     for (std::size_t k = 0; k < modifiers.size(); ++k)
         if (modifiers[k].name == name) return k;

@@ -31,6 +31,10 @@ struct ModifierBasis {
     std::size_t find(const std::string& name) const;  // index, or modifiers.size() when there is none
 };
 
+// The subject's other side's modifier: "eyes/r-eye-bag-min" <-> "eyes/l-eye-bag-min"; a name without a side is its
+// own mirror.
+std::string mirroredModifierName(const std::string& name);
+
 // The basis file: "ABMODBAS" magic, format version, vertex count, then each modifier's name, group and sparse
 // offsets (little-endian). Written atomically; a truncated or foreign file is refused naming the file.
 void saveModifierBasis(const ModifierBasis& basis, const std::filesystem::path& file);

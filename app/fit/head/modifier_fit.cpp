@@ -104,13 +104,9 @@ std::vector<std::pair<std::size_t, std::size_t>> mirroredModifiers(const Modifie
     std::vector<std::pair<std::size_t, std::size_t>> pairs;
     for (std::size_t k = 0; k < basis.modifiers.size(); ++k) {
         const std::string& name = basis.modifiers[k].name;
-        const auto slash = name.find('/');
-        if (slash == std::string::npos || slash + 2 >= name.size() || name[slash + 1] != 'r' || name[slash + 2] != '-')
-            continue;
-        std::string left = name;
-        left[slash + 1] = 'l';
-        const std::size_t j = basis.find(left);
-        if (j < basis.modifiers.size()) pairs.emplace_back(k, j);
+        const std::string other = mirroredModifierName(name);
+        const std::size_t j = basis.find(other);
+        if (other < name && j < basis.modifiers.size()) pairs.emplace_back(k, j);  // from the "r-" side: each pair once
     }
     return pairs;
 }
