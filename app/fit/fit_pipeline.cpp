@@ -29,6 +29,9 @@ constexpr double kBigHairOutlineSlackMm = 15.0;
 constexpr double kNeckClothesUnderChinMm = 25.0;
 // ... and behind the ears from this far under the ear's middle, under the lobe.
 constexpr double kNeckClothesUnderEarMm = 40.0;
+// Hair tucked behind the face is read down to this far under the chin: the fade at the bottom of the heights read
+// (SideFaceClearance::ramp) lies under it, and a lock's end beside the jaw goes back with the rest.
+constexpr double kTuckUnderChinMm = 15.0;
 
 using Clock = std::chrono::steady_clock;
 
@@ -296,10 +299,24 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
             HairPhotoMasks masks{m.frontHair, out.frontMask, m.sideHair, out.sideMask, out.fit.front, out.fit.side};
             out.hairTrimmedVertices = trimShortHairToPhotos(hair->mesh, out.fit.mesh, masks);
         }
-        // The fitted head's ears stand out further than those MakeHuman's styles were made over.
+        // The fitted head's ears stand out further than those MakeHuman's styles were made over (under the hair as
+        // placed: tucked under what then goes behind the face, the ear's top stays under the temple's hair and the
+        // head's side round the ear keeps its shape).
         if (hairCoversEars(out.hair.style))
             for (AvatarPart& part : out.parts)
                 if (part.name == "head") tuckEarsUnderHair(part.mesh, hair->mesh, jawTopDepth(base_, out.fit.mesh));
+        // Long hair and a bob hang over the ears; where the side photo shows the side of the face bare, the hair
+        // goes behind it.
+        if (hairCoversEars(out.hair.style)) {
+            const auto at = [&](int k) { return out.fit.mesh.positions[base_.frontFeatures.at(landmarkName(k))]; };
+            SideFaceClearance clearSide;
+            clearSide.innerX = 0.5 * (std::abs(at(36).x) + std::abs(at(45).x));
+            clearSide.frontZ = 0.5 * (at(36).z + at(45).z);
+            clearSide.topY = -1e9;
+            for (int k = 17; k <= 26; ++k) clearSide.topY = std::max(clearSide.topY, at(k).y);
+            clearSide.bottomY = at(8).y - kTuckUnderChinMm;
+            out.hairTuckedVertices = tuckHairBehindTheFace(hair->mesh, out.fit.side, m.sideHair, clearSide);
+        }
         out.parts.push_back(std::move(*hair));
     }
     // The brows onto the photo's own (which the texture shows where the fit put dlib's brow points): dlib puts them on

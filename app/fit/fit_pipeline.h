@@ -72,6 +72,9 @@ struct FitOutcome {
     // With short hair: how many of the hair part's vertices went where the photos show skin (fit/parts/hair_part.h
     // trimShortHairToPhotos); 0 otherwise.
     int hairTrimmedVertices = 0;
+    // Long hair or a bob: the hair part's vertices moved back behind the side photo's hair edge beside the face
+    // (fit/parts/hair_part.h tuckHairBehindTheFace); 0 otherwise.
+    int hairTuckedVertices = 0;
     // With a bob: how far down the side photo shows the hair behind the head, and how the hair part's
     // length was scaled to it (fitHairLengthBehind); not measured otherwise.
     HairLength hairLength;

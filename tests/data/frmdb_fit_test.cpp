@@ -244,8 +244,9 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
         // Seen from either side, the head shows nowhere through long hair or a bob: the fitted head's ears stood out
         // through long01 and were drawn as an arc on the hair (005, 006, 007) until tuckEarsUnderHair. Short hair and
         // a ponytail leave the ears out (as 002's, 003's and 004's photos show them), so the ears stand out there.
+        constexpr double kThroughHairMm = 5.0;
         const double jawZ = jawTopDepth(pipeline().baseHead(), mesh);
-        int through = 0, underHair = 0;
+        int through = 0, outside = 0, underHair = 0;
         for (const double side : {1.0, -1.0}) {
             Mesh fromSide = part.mesh;  // looking along -x (side +1) or +x (side -1): depth is side * x
             for (glm::dvec3& q : fromSide.positions) q = {q.z, q.y, side * q.x};
@@ -254,7 +255,11 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
                 const double hairDepth = fromSide.frontZ(p.z, p.y);
                 if (std::isnan(hairDepth)) continue;
                 ++underHair;
-                if (side * p.x > hairDepth) ++through;
+                // Through the hair's outer layer: standing out of hair that lies under it by less than an ear stands
+                // out (hair deeper under the head is hidden; where the hair went behind the face, the ear is bare).
+                const double standsOut = side * p.x - hairDepth;
+                if (standsOut > 0.0) ++outside;
+                if (standsOut > 0.0 && standsOut < kThroughHairMm) ++through;
             }
         }
         std::printf("%s %s: %d of the %d head vertices beside the ears under hair show through it from the side\n", person,
@@ -280,12 +285,47 @@ TEST_P(FrmdbFit, FitsWithoutErrorAndWritesOverlays) {
             const bool inEar = std::abs(p.z - ear.z) < 15.0 && std::abs(p.y - ear.y) < 30.0;
             (inEar ? tuckedEar : tuckedSide) = std::max(inEar ? tuckedEar : tuckedSide, moved);
         }
+        // Where the side photo shows the ear bare with the hair behind it (tuckHairBehindTheFace; by eye: 001's and
+        // 008's ears in both profiles), the avatar's ear is bare from the side too: no hair outside it or hair only
+        // deep under it. Before, long01 and bob02 hid every long-haired or bobbed visitor's (0 of 337 vertices);
+        // now 008 222 and 269, 001 133 and 38 (in Img_53 her hair's edge lies over the ear's back).
+        int bareEar = 0, earSeen = 0;
+        {
+            const BaseHead& base = pipeline().baseHead();
+            Mesh fromSide = part.mesh;  // looking along -x, at the right ear (x > 0 on the base head's right side)
+            const double side = ear.x > 0.0 ? 1.0 : -1.0;
+            for (glm::dvec3& q : fromSide.positions) q = {q.z, q.y, side * q.x};
+            for (const auto v : rigidlyMovedVertices(*base.modifiers, kRightEarTranslation)) {
+                const glm::dvec3& p = outcome.parts.front().mesh.positions[v];
+                const double hairDepth = fromSide.frontZ(p.z, p.y);
+                ++earSeen;
+                if (std::isnan(hairDepth) || side * p.x - hairDepth > kThroughHairMm) ++bareEar;
+            }
+        }
+        std::printf("%s %s: %d of the right ear's %d vertices bare from the side (%d hair vertices tucked behind the face)\n",
+                    person, std::get<1>(GetParam()), bareEar, earSeen, outcome.hairTuckedVertices);
+        if (std::string(person) == "008") {
+            EXPECT_GT(bareEar, earSeen / 2);
+        }
+        if (std::string(person) == "001") {
+            EXPECT_GT(bareEar, earSeen / 10);
+        }
         std::printf("%s %s: head vertices tucked under the hair by up to %.1f mm in the ears, %.1f mm elsewhere\n", person,
                     std::get<1>(GetParam()), tuckedEar, tuckedSide);
         EXPECT_LT(tuckedSide, 2.0);
         // (003's short hair, trimmed to his fade, leaves no hair beside his ears at all.)
-        if (hairCoversEars(outcome.hair.style)) EXPECT_EQ(through, 0);
-        else EXPECT_TRUE(underHair == 0 || through > 0) << "the ears vanished under " << toString(outcome.hair.style) << " hair";
+        // Where hair went behind the face, the bare ear meets the tucked hair's front edge: a few of its vertices lie
+        // just outside the hair there (005 6 and 3 of 222 and 90, 008 15 and 10 of about 790, 006's right profile 47
+        // of 386: by eye an ear in front of the hair, as in her photo).
+        if (hairCoversEars(outcome.hair.style)) {
+            if (outcome.hairTuckedVertices == 0) {
+                EXPECT_EQ(through, 0);
+            } else {
+                EXPECT_LT(through, underHair / 7);
+            }
+        } else {
+            EXPECT_TRUE(underHair == 0 || outside > 0) << "the ears vanished under " << toString(outcome.hair.style) << " hair";
+        }
     }
     // The avatar's outline above the brows is the photos': with short hair the head fit follows the outline, so the
     // hair part must add no volume (short02 over the fitted heads of 002 and 003: 0.74-0.81; short04 0.91-0.95).

@@ -494,3 +494,65 @@ TEST(HairPart, WithoutThePhotosMasksTheShortHairIsKeptAndBadMasksAreAnInternalEr
         EXPECT_EQ(e.kind(), ErrorKind::Internal);
     }
 }
+
+namespace {
+
+// The side photo's hair (in the frame of frame(), face to the right): hair behind z `edge` from y -40 up, none ahead
+// of it (the bare cheek and ear); nothing at all under y -40 (the shoulders' clothes).
+cv::Mat hairBehind(double edge) {
+    cv::Mat m = cv::Mat::zeros(400, 400, CV_8U);
+    m(cv::Rect(0, 0, static_cast<int>(edge) + 200, 241)).setTo(255);
+    return m;
+}
+
+SideFaceClearance cheeks() {
+    SideFaceClearance c;
+    c.topY = 40.0;
+    c.bottomY = -60.0;
+    c.frontZ = 60.0;
+    c.innerX = 40.0;
+    return c;
+}
+
+}  // namespace
+
+TEST(HairPart, HairOverTheBareSideOfTheFaceGoesBehindTheSidePhotosHairKeepingItsOrder) {
+    // Locks on both sides of the face (x +-75, beyond innerX + sideRamp) from z -40 to 40 at every height from -80 to
+    // 70, and a fringe's strand at x 10; the photo's hair begins 10 mm behind the ear holes.
+    Mesh hair;
+    for (const double x : {-75.0, 10.0, 75.0})
+        for (double y = -80.0; y <= 70.0; y += 5.0)
+            for (double z = -40.0; z <= 40.0; z += 5.0) hair.positions.emplace_back(x, y, z);
+    const Mesh before = hair;
+    const SideFaceClearance o = cheeks();
+    const int moved = tuckHairBehindTheFace(hair, frame(), hairBehind(-10.0), o);
+    EXPECT_GT(moved, 0);
+    const double edge = -10.0 - o.margin;  // where the tucked hair ends (the photo's pixels: within 1 mm)
+    for (std::size_t i = 0; i < hair.positions.size(); ++i) {
+        const glm::dvec3& p = hair.positions[i];
+        const glm::dvec3& q = before.positions[i];
+        EXPECT_EQ(p.x, q.x) << i;
+        EXPECT_EQ(p.y, q.y) << i;
+        EXPECT_LE(p.z, q.z) << i;  // only ever back
+        const bool tucked = std::abs(q.x) > o.innerX + o.sideRamp && q.y >= -40.0 && q.y <= o.topY - o.ramp && q.z > edge - o.band + 1.0;
+        if (std::abs(q.x) < o.innerX || q.y > o.topY || q.y < -40.0 || q.z <= edge - 3.0 * o.band) {
+            // The fringe, over the heights read, where the photo shows no hair (no edge), and far enough behind it.
+            EXPECT_NEAR(p.z, q.z, q.z <= edge - 3.0 * o.band ? 0.2 : 0.0) << i;
+        } else if (tucked) {
+            EXPECT_LE(p.z, edge + 1.0) << i;  // behind the photo's hair edge
+            EXPECT_GT(p.z, edge - o.band - 1.0) << i;
+        }
+    }
+    // The strands keep their order along each row: z' rises with z (no triangle turns over).
+    for (std::size_t i = 1; i < hair.positions.size(); ++i) {
+        if (before.positions[i].x == before.positions[i - 1].x && before.positions[i].y == before.positions[i - 1].y) {
+            EXPECT_GT(hair.positions[i].z, hair.positions[i - 1].z) << i;
+        }
+    }
+
+    // No photo, or one that shows hair ahead of the face's side (hair over the ears): nothing moves.
+    Mesh untouched = before;
+    EXPECT_EQ(tuckHairBehindTheFace(untouched, frame(), cv::Mat(), o), 0);
+    EXPECT_EQ(tuckHairBehindTheFace(untouched, frame(), hairBehind(60.0), o), 0);
+    EXPECT_EQ(untouched.positions, before.positions);
+}

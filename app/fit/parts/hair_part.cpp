@@ -534,6 +534,65 @@ HairLength fitHairLengthBehind(Mesh& hair, const Mesh& fittedHead, const PhotoFr
     return out;
 }
 
+int tuckHairBehindTheFace(Mesh& hair, const PhotoFrame& side, const cv::Mat& sideHair, const SideFaceClearance& o) {
+    if (sideHair.empty() || hair.positions.empty() || o.step <= 0.0 || side.mmPerPixel <= 0.0 || o.topY <= o.bottomY)
+        return 0;
+    if (sideHair.type() != CV_8U)
+        throw BoothError(ErrorKind::Internal, "", "tuckHairBehindTheFace: the side photo's hair pixels are not 8-bit");
+    glm::dvec3 lo, hi;
+    hair.bounds(lo, hi);
+    const auto isHair = [&](double z, double y) {
+        const cv::Point2d px = side.toPixel({z, y});
+        const int c = static_cast<int>(std::lround(px.x)), r = static_cast<int>(std::lround(px.y));
+        return c >= 0 && r >= 0 && c < sideHair.cols && r < sideHair.rows && sideHair.at<std::uint8_t>(r, c) != 0;
+    };
+    // The photo's hair edge, height by height: going back from frontZ, where the first run of hair begins.
+    const int rows = static_cast<int>(std::floor((o.topY - o.bottomY) / o.step)) + 1;
+    std::vector<double> edge(static_cast<std::size_t>(rows), std::numeric_limits<double>::quiet_NaN());
+    const int runSteps = std::max(1, static_cast<int>(std::lround(o.run / o.step)));
+    for (int i = 0; i < rows; ++i) {
+        const double y = o.bottomY + i * o.step;
+        int inRun = 0;
+        for (double z = o.frontZ; z >= lo.z; z -= o.step) {
+            inRun = isHair(z, y) ? inRun + 1 : 0;
+            if (inRun == runSteps) {
+                edge[static_cast<std::size_t>(i)] = z + (runSteps - 1) * o.step;
+                break;
+            }
+        }
+    }
+    // Smoothed along the height over the rows that show hair (a Gaussian's weights, renormalised).
+    std::vector<double> smooth(edge.size(), std::numeric_limits<double>::quiet_NaN());
+    const int reach = static_cast<int>(std::ceil(3.0 * o.smooth / o.step));
+    for (int i = 0; i < rows; ++i) {
+        if (std::isnan(edge[static_cast<std::size_t>(i)])) continue;
+        double sum = 0.0, weights = 0.0;
+        for (int j = std::max(0, i - reach); j <= std::min(rows - 1, i + reach); ++j) {
+            const double e = edge[static_cast<std::size_t>(j)];
+            if (std::isnan(e)) continue;
+            const double d = (j - i) * o.step / std::max(o.smooth, 1e-6);
+            const double w = std::exp(-0.5 * d * d);
+            sum += w * e;
+            weights += w;
+        }
+        smooth[static_cast<std::size_t>(i)] = sum / weights;
+    }
+    const double band = std::max(o.band, 1e-6);
+    int moved = 0;
+    for (glm::dvec3& p : hair.positions) {
+        const double sideways = smoothstep((std::abs(p.x) - o.innerX) / std::max(o.sideRamp, 1e-6));
+        if (sideways <= 0.0 || p.y < o.bottomY || p.y > o.topY) continue;
+        const double e = smooth[static_cast<std::size_t>(std::clamp(static_cast<int>(std::lround((p.y - o.bottomY) / o.step)), 0, rows - 1))] - o.margin;
+        if (std::isnan(e) || p.z <= e - band) continue;
+        const double ends = std::min(p.y - o.bottomY, o.topY - p.y) / std::max(o.ramp, 1e-6);
+        const double tucked = e - band + band * std::tanh((p.z - e + band) / band);
+        const double z = p.z + sideways * smoothstep(ends) * (tucked - p.z);
+        if (p.z - z > 1.0) ++moved;
+        p.z = z;
+    }
+    return moved;
+}
+
 const char* hairProxyName(HairStyle style) {
     switch (style) {
         case HairStyle::None: return nullptr;

@@ -142,6 +142,33 @@ struct HairLength {
 HairLength fitHairLengthBehind(Mesh& hair, const Mesh& fittedHead, const PhotoFrame& side, const cv::Mat& sideHair,
                                double jawZ, const HairLengthFit& options = {});
 
+// Where the side photo shows the side of the face bare and its hair behind (tuckHairBehindTheFace), in millimetres
+// of head space.
+struct SideFaceClearance {
+    double topY = 0.0, bottomY = 0.0;  // the heights read: the brows' top and the chin (set by the caller)
+    double frontZ = 0.0;               // the side photo is read from this depth back (the eyes' outer corners)
+    double innerX = 0.0;               // hair nearer the middle than this is the face's (keepFaceClear's) and stays
+    double sideRamp = 20.0;            // from innerX out, the tuck comes in fully over this
+    double ramp = 10.0;                // at the top and the bottom of the heights read, it fades out over this
+    double run = 3.0;                  // the photo's hair begins at the first run of hair this long going back
+    double band = 4.0;                 // what lay ahead of the photo's hair goes into this band behind its edge
+    double margin = 3.0;               // ... less this: the photo's hair mask reaches over the ear's rim
+    double smooth = 4.0;               // the hair's edge varies along the height with a Gaussian of this deviation
+    double step = 0.5;                 // the photo is read every this many millimetres, back and down
+};
+
+// MakeHuman's long hair and bob hang over the ears down the side of the face; many visitors' hair lies behind the
+// ears (FRMDB 008's and 001's profiles show the ear and the cheek before it bare, the hair behind them), and the
+// avatar's side and three-quarter views showed a wall of hair across the cheek. Height by height between
+// `bottomY` and `topY`, going back from `frontZ` in the side photo's hair pixels (CV_8U, 255 on hair; `side`: its
+// frame), the photo's hair begins at the first run of `run` of hair; the edge is smoothed along the height, and
+// heights whose row shows no hair are left. Hair vertices beside the face (|x| over innerX, in full from innerX +
+// sideRamp) that lie ahead of that edge go back behind it: depth is mapped monotonically (z' = e - b + b tanh((z -
+// e + b) / b) ahead of e - b, with e the edge and b `band`), so the strands keep their order and nothing turns over;
+// the move fades out over `ramp` at the top and the bottom. Both sides read the one profile (faces are nearly
+// symmetric). Returns how many vertices moved by more than 1 mm.
+int tuckHairBehindTheFace(Mesh& hair, const PhotoFrame& side, const cv::Mat& sideHair, const SideFaceClearance& clearance);
+
 // What the photos show of the hair (hairPixels: CV_8U, 255 on hair, in each photo as taken, with its person mask)
 // and how their pixels map to the head (the fit's frames).
 struct HairPhotoMasks {
