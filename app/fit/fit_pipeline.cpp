@@ -33,6 +33,21 @@ constexpr double kNeckClothesUnderEarMm = 40.0;
 // (SideFaceClearance::ramp) lies under it, and a lock's end beside the jaw goes back with the rest.
 constexpr double kTuckUnderChinMm = 15.0;
 
+// Where the side of the face begins on the fitted head, for the hair beside it (the texture's repaint and the hair
+// part's tuck): |x| of the eyes' outer corners (ibug 36 and 45) and the brows' top (17-26).
+struct FaceSide {
+    double innerX = 0.0, browsTopY = 0.0;
+};
+
+FaceSide faceSide(const BaseHead& base, const Mesh& fitted) {
+    const auto at = [&](int k) { return fitted.positions[base.frontFeatures.at(landmarkName(k))]; };
+    FaceSide f;
+    f.innerX = 0.5 * (std::abs(at(36).x) + std::abs(at(45).x));
+    f.browsTopY = -1e9;
+    for (int k = 17; k <= 26; ++k) f.browsTopY = std::max(f.browsTopY, at(k).y);
+    return f;
+}
+
 using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
@@ -244,10 +259,10 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         if (hairCoversEars(out.hair.style)) {
             // Long hair or a bob beside the face: the hair part leaves the cheeks bare, so the photo's hair on them goes.
             const auto at = [&](int k) { return out.fit.mesh.positions[base_.frontFeatures.at(landmarkName(k))]; };
+            const FaceSide face = faceSide(base_, out.fit.mesh);
             FaceSides sides;
-            sides.innerX = 0.5 * (std::abs(at(36).x) + std::abs(at(45).x));
-            sides.topY = -1e9;
-            for (int k = 17; k <= 26; ++k) sides.topY = std::max(sides.topY, at(k).y);
+            sides.innerX = face.innerX;
+            sides.topY = face.browsTopY;
             sides.bottomY = out.hair.beard ? at(30).y : at(8).y;
             // The head's origin lies between the ear holes; the ear reaches about 15 mm ahead of its middle.
             sides.frontOfZ = (out.fit.earsPlaced ? out.fit.earMiddleMm.z : 0.0) + 15.0;
@@ -302,18 +317,17 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         // The fitted head's ears stand out further than those MakeHuman's styles were made over (under the hair as
         // placed: tucked under what then goes behind the face, the ear's top stays under the temple's hair and the
         // head's side round the ear keeps its shape).
-        if (hairCoversEars(out.hair.style))
+        if (hairCoversEars(out.hair.style)) {
             for (AvatarPart& part : out.parts)
                 if (part.name == "head") tuckEarsUnderHair(part.mesh, hair->mesh, jawTopDepth(base_, out.fit.mesh));
-        // Long hair and a bob hang over the ears; where the side photo shows the side of the face bare, the hair
-        // goes behind it.
-        if (hairCoversEars(out.hair.style)) {
+            // Long hair and a bob hang over the ears; where the side photo shows the side of the face bare, the
+            // hair goes behind it.
             const auto at = [&](int k) { return out.fit.mesh.positions[base_.frontFeatures.at(landmarkName(k))]; };
+            const FaceSide face = faceSide(base_, out.fit.mesh);
             SideFaceClearance clearSide;
-            clearSide.innerX = 0.5 * (std::abs(at(36).x) + std::abs(at(45).x));
+            clearSide.innerX = face.innerX;
             clearSide.frontZ = 0.5 * (at(36).z + at(45).z);
-            clearSide.topY = -1e9;
-            for (int k = 17; k <= 26; ++k) clearSide.topY = std::max(clearSide.topY, at(k).y);
+            clearSide.topY = face.browsTopY;
             clearSide.bottomY = at(8).y - kTuckUnderChinMm;
             out.hairTuckedVertices = tuckHairBehindTheFace(hair->mesh, out.fit.side, m.sideHair, clearSide);
         }

@@ -38,12 +38,6 @@ glm::dvec3 meanVertex(const Mesh& mesh, const BaseHead& base, int from, int to) 
     return sum / static_cast<double>(to - from + 1);
 }
 
-// Whether the pixel nearest `p` lies on the silhouette (outside the image: no).
-bool inMask(const cv::Mat& mask, const cv::Point2d& p) {
-    const int x = static_cast<int>(std::lround(p.x)), y = static_cast<int>(std::lround(p.y));
-    return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<unsigned char>(y, x) != 0;
-}
-
 // Walks from `start` along `dir` (pixels) and returns the last pixel inside the mask before it is left; this is
 // where a half-line from the view's centre crosses the head's outline (METHODS §1 step 4).
 cv::Point2d outlineCrossing(const cv::Mat& mask, const cv::Point2d& start, const cv::Point2d& dir, const char* view) {
@@ -206,6 +200,11 @@ std::optional<cv::Point2d> outlineAlongNormal(const cv::Mat& mask, const cv::Poi
 }
 
 }  // namespace
+
+bool inMask(const cv::Mat& mask, const cv::Point2d& p) {
+    const int x = static_cast<int>(std::lround(p.x)), y = static_cast<int>(std::lround(p.y));
+    return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<unsigned char>(y, x) != 0;
+}
 
 glm::dvec2 PhotoFrame::toHead(const cv::Point2d& px) const {
     const double u = mirrored ? imageWidth - 1 - px.x : px.x;

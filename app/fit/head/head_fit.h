@@ -100,6 +100,9 @@ struct PhotoFrame {
     cv::Point2d toPixel(const glm::dvec2& head) const;
 };
 
+// Whether the pixel nearest `p` lies on `mask` (CV_8U, nonzero on it; outside the image: no).
+bool inMask(const cv::Mat& mask, const cv::Point2d& p);
+
 struct HeadFit {
     Mesh mesh;                   // the fitted head (base head topology)
     Mesh scaledBase;             // the base head after steps 1-2 (modifiers, scaling), before the warp

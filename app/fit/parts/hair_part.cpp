@@ -541,11 +541,6 @@ int tuckHairBehindTheFace(Mesh& hair, const PhotoFrame& side, const cv::Mat& sid
         throw BoothError(ErrorKind::Internal, "", "tuckHairBehindTheFace: the side photo's hair pixels are not 8-bit");
     glm::dvec3 lo, hi;
     hair.bounds(lo, hi);
-    const auto isHair = [&](double z, double y) {
-        const cv::Point2d px = side.toPixel({z, y});
-        const int c = static_cast<int>(std::lround(px.x)), r = static_cast<int>(std::lround(px.y));
-        return c >= 0 && r >= 0 && c < sideHair.cols && r < sideHair.rows && sideHair.at<std::uint8_t>(r, c) != 0;
-    };
     // The photo's hair edge, height by height: going back from frontZ, where the first run of hair begins.
     const int rows = static_cast<int>(std::floor((o.topY - o.bottomY) / o.step)) + 1;
     std::vector<double> edge(static_cast<std::size_t>(rows), std::numeric_limits<double>::quiet_NaN());
@@ -554,7 +549,7 @@ int tuckHairBehindTheFace(Mesh& hair, const PhotoFrame& side, const cv::Mat& sid
         const double y = o.bottomY + i * o.step;
         int inRun = 0;
         for (double z = o.frontZ; z >= lo.z; z -= o.step) {
-            inRun = isHair(z, y) ? inRun + 1 : 0;
+            inRun = inMask(sideHair, side.toPixel({z, y})) ? inRun + 1 : 0;
             if (inRun == runSteps) {
                 edge[static_cast<std::size_t>(i)] = z + (runSteps - 1) * o.step;
                 break;
