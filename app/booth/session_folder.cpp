@@ -129,6 +129,7 @@ nlohmann::json fitReport(const FitOutcome& o, const SessionFolderContents& conte
                                                {"factor", o.hairLength.factor}};
         report["hair"]["forehead_shown_mm"] = o.foreheadShownMm;
         report["hair"]["trimmed_vertices"] = o.hairTrimmedVertices;
+        report["hair"]["pulled_in_vertices"] = o.hairPulledInVertices;
         report["hair"]["tucked_behind_face_vertices"] = o.hairTuckedVertices;
     }
     if (!o.fit.modifierWeights.empty()) {

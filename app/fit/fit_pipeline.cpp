@@ -314,6 +314,10 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
             HairPhotoMasks masks{m.frontHair, out.frontMask, m.sideHair, out.sideMask, out.fit.front, out.fit.side};
             out.hairTrimmedVertices = trimShortHairToPhotos(hair->mesh, out.fit.mesh, masks);
         }
+        if (out.hair.style == HairStyle::Short) {
+            HairPhotoMasks masks{m.frontHair, out.frontMask, m.sideHair, out.sideMask, out.fit.front, out.fit.side};
+            out.hairPulledInVertices = pullShortHairIntoOutlines(hair->mesh, out.fit.mesh, masks);
+        }
         // The fitted head's ears stand out further than those MakeHuman's styles were made over (under the hair as
         // placed: tucked under what then goes behind the face, the ear's top stays under the temple's hair and the
         // head's side round the ear keeps its shape).

@@ -72,6 +72,8 @@ struct FitOutcome {
     // With short hair: how many of the hair part's vertices went where the photos show skin (fit/parts/hair_part.h
     // trimShortHairToPhotos); 0 otherwise.
     int hairTrimmedVertices = 0;
+    // Of short hair, the vertices brought into the photos' outlines by more than 1 mm (pullShortHairIntoOutlines).
+    int hairPulledInVertices = 0;
     // Long hair or a bob: the hair part's vertices moved back behind the side photo's hair edge beside the face
     // (fit/parts/hair_part.h tuckHairBehindTheFace); 0 otherwise.
     int hairTuckedVertices = 0;

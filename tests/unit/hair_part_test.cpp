@@ -477,6 +477,50 @@ TEST(HairPart, AStrandCardReachingOutOfThePhotosOutlineGoesWhole) {
     EXPECT_EQ(cards.triangles.size(), 12u);
 }
 
+// A haircut of two layers, 5 and 10 mm off a round head of radius 90, in photos whose outline is a disc of radius
+// 92: where a photo sees a layer's edge, it comes in to the outline (within the margin and a pixel); where neither
+// photo sees it edge-on (between the views) it stays; the layers keep their order without meeting, and nothing goes
+// nearer the scalp than the least offset.
+TEST(HairPart, ShortHairStandingOutOfThePhotosOutlinesComesInKeepingItsLayers) {
+    const Mesh head = sphere(90.0, -200.0);
+    Mesh hair = sphere(95.0, -60.0);
+    const Mesh outer = sphere(100.0, -60.0);
+    const auto innerCount = static_cast<std::uint32_t>(hair.positions.size());
+    for (const auto& p : outer.positions) hair.positions.push_back(p);
+    for (const auto& t : outer.triangles) hair.triangles.push_back(t + glm::uvec3(innerCount));
+    HairPhotoMasks photos = roundHeadPhotos(-100.0);
+    photos.frontPerson.setTo(0);
+    cv::circle(photos.frontPerson, {200, 200}, 92, cv::Scalar(255), cv::FILLED);
+    photos.sidePerson = photos.frontPerson.clone();
+    const Mesh before = hair;
+    const int moved = pullShortHairIntoOutlines(hair, head, photos);
+    EXPECT_GT(moved, 100);
+    ASSERT_EQ(hair.positions.size(), before.positions.size());
+    int keptBetween = 0;
+    for (std::size_t i = 0; i < hair.positions.size(); ++i) {
+        const glm::dvec3& p = hair.positions[i];
+        const glm::dvec3& was = before.positions[i];
+        EXPECT_LE(glm::length(glm::dvec2(p.x, p.y)), 92.0 + 1.0 + 1.5) << "out of the front photo's outline: " << i;
+        EXPECT_LE(glm::length(glm::dvec2(p.z, p.y)), 92.0 + 1.0 + 1.5) << "out of the side photo's outline: " << i;
+        EXPECT_GE(glm::length(p), 90.5 - 1e-6) << "under the least offset: " << i;
+        EXPECT_NEAR(glm::length(glm::cross(glm::normalize(p), glm::normalize(was))), 0.0, 0.02) << "not along the normal";
+        // Half-way between the front and the side view, at the equator, neither photo sees the hair's edge.
+        if (std::abs(p.y) < 10.0 && std::abs(std::abs(was.x) - std::abs(was.z)) < 5.0) {
+            EXPECT_EQ(p, was) << i;
+            ++keptBetween;
+        }
+    }
+    EXPECT_GT(keptBetween, 0);
+    for (std::uint32_t i = 0; i < innerCount; ++i)
+        EXPECT_GT(glm::length(hair.positions[innerCount + i]), glm::length(hair.positions[i]) + 0.1)
+            << "the outer layer met or went under the inner one at " << i;
+    Mesh unchanged = before;
+    HairPhotoMasks none = photos;
+    none.sidePerson = cv::Mat();
+    EXPECT_EQ(pullShortHairIntoOutlines(unchanged, head, none), 0);
+    EXPECT_EQ(unchanged.positions, before.positions);
+}
+
 TEST(HairPart, WithoutThePhotosMasksTheShortHairIsKeptAndBadMasksAreAnInternalError) {
     const Mesh head = sphere(90.0, -200.0);
     Mesh hair = sphere(91.5, -60.0);

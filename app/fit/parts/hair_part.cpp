@@ -110,6 +110,19 @@ double valueAt(const cv::Mat& image, const cv::Point2d& px, double beyond) {
     return static_cast<double>(image.at<float>(y, x));
 }
 
+// A CV_32F image's value at `px` interpolated bilinearly between pixel centres (clamped at the border), or
+// `beyond` outside the image.
+double bilinearAt(const cv::Mat& image, const cv::Point2d& px, double beyond) {
+    if (px.x < -0.5 || px.y < -0.5 || px.x > image.cols - 0.5 || px.y > image.rows - 0.5) return beyond;
+    const double x = std::clamp(px.x, 0.0, image.cols - 1.0), y = std::clamp(px.y, 0.0, image.rows - 1.0);
+    const int x0 = std::max(0, std::min(static_cast<int>(x), image.cols - 2));
+    const int y0 = std::max(0, std::min(static_cast<int>(y), image.rows - 2));
+    const int x1 = std::min(x0 + 1, image.cols - 1), y1 = std::min(y0 + 1, image.rows - 1);
+    const double fx = x - x0, fy = y - y0;
+    const auto at = [&](int yy, int xx) { return static_cast<double>(image.at<float>(yy, xx)); };
+    return (1 - fy) * ((1 - fx) * at(y0, x0) + fx * at(y0, x1)) + fy * ((1 - fx) * at(y1, x0) + fx * at(y1, x1));
+}
+
 }  // namespace
 
 int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMasks& photos, const HairTrim& trim) {
@@ -207,6 +220,49 @@ int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMas
     }
     if (!trimmed.empty()) hair = withoutVertices(hair, trimmed);
     return static_cast<int>(trimmed.size());
+}
+
+int pullShortHairIntoOutlines(Mesh& hair, const Mesh& fittedHead, const HairPhotoMasks& photos, const HairPull& pull) {
+    const auto usable = [](const cv::Mat& person) { return !person.empty() && person.type() == CV_8U; };
+    if (!usable(photos.frontPerson) || !usable(photos.sidePerson) || photos.front.mmPerPixel <= 0.0 ||
+        photos.side.mmPerPixel <= 0.0 || fittedHead.positions.empty())
+        return 0;
+    // Signed distances to each photo's outline, in millimetres, out of the person positive.
+    const auto signedDistance = [](const cv::Mat& person, double mmPerPixel) {
+        cv::Mat out, in;
+        cv::distanceTransform(person == 0, out, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+        cv::distanceTransform(person != 0, in, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+        return cv::Mat((out - in) * mmPerPixel);
+    };
+    const cv::Mat frontDistance = signedDistance(photos.frontPerson, photos.front.mmPerPixel);
+    const cv::Mat sideDistance = signedDistance(photos.sidePerson, photos.side.mmPerPixel);
+    const std::vector<glm::dvec3> normals = fittedHead.vertexNormals();
+    const NearestVertex nearestOnHead(fittedHead.positions, pull.reach);
+    // How far along the normal a point is past where the view's outline (plus the margin) lies: its distance out
+    // of it over the part of n in the view's plane (to first order; a spot the view sees edge-on moves it the most).
+    const auto past = [&](const cv::Mat& distance, const PhotoFrame& frame, const glm::dvec2& at, const glm::dvec2& nInView) {
+        const double d = bilinearAt(distance, frame.toPixel(at), std::numeric_limits<double>::infinity());
+        return (d - pull.margin) / std::max(glm::length(nInView), 0.3);
+    };
+    int moved = 0;
+    for (glm::dvec3& p : hair.positions) {
+        const auto spot = nearestOnHead(p);
+        if (!spot) continue;
+        const glm::dvec3& n = normals[*spot];
+        const double offset = glm::dot(p - fittedHead.positions[*spot], n);
+        const double beyond = std::max(past(frontDistance, photos.front, {p.x, p.y}, {n.x, n.y}),
+                                       past(sideDistance, photos.side, {p.z, p.y}, {n.z, n.y}));
+        // The offset the outline allows here, and the soft limit under it: offsets within `band` of it and past it
+        // are compressed into the band (z' = a - b + b tanh((z - a + b) / b)), the haircut's layers in order.
+        const double allowed = offset - beyond, b = pull.band;
+        if (!std::isfinite(allowed) || offset <= allowed - b) continue;
+        double wanted = allowed - b + b * std::tanh((offset - allowed + b) / b);
+        wanted = std::max(wanted, std::min(offset, pull.minOffset));
+        if (wanted >= offset) continue;
+        p -= (offset - wanted) * n;
+        moved += offset - wanted > 1.0;
+    }
+    return moved;
 }
 
 double foreheadShownMm(const cv::Mat& hair, const std::array<cv::Point2d, 68>& points, const PhotoFrame& front,

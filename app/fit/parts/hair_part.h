@@ -196,6 +196,23 @@ struct HairTrim {
 // placed on. Returns how many vertices went.
 int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMasks& photos, const HairTrim& trim = {});
 
+// How short hair is brought inside the photos' outlines (pullShortHairIntoOutlines), in millimetres.
+struct HairPull {
+    double margin = 1.0;     // a vertex may stand this far out of an outline
+    double reach = 30.0;     // hair farther than this from the head hangs free and is left
+    double minOffset = 0.5;  // no vertex is brought nearer the scalp than this (or than it was)
+    double band = 3.0;       // the layers at and past the outline are compressed into this band under it
+};
+
+// Short hair lies in the head's own outline: the head fit followed the photos' outlines, hair included, and
+// MakeHuman's short04 stands up to 10 mm off the scalp (FRMDB 002's and 003's haircut stood 9-10 mm out of the side
+// photo's outline at the back of the head). Each hair vertex within `reach` of the head moves along its spot's
+// normal: the offset from the scalp that either photo's outline (the person masks of `photos`, plus `margin`)
+// allows there is read from the photos' signed distances, and the offsets within `band` of it and past it are
+// compressed monotonically into that band, so the haircut's layers keep their order and do not meet; no vertex goes
+// nearer the scalp than `minOffset`. Returns how many vertices moved by more than 1 mm.
+int pullShortHairIntoOutlines(Mesh& hair, const Mesh& fittedHead, const HairPhotoMasks& photos, const HairPull& pull = {});
+
 // The trim reads the photos' hair by colour (hairPixels): with the hair's colour this near the skin's (CIE L*a*b*
 // distance of the estimate's models) light hair at the hairline reads as skin, and the fit leaves short04 whole
 // (the blond of the short-hair test came out worse trimmed, at 24-28; everyone else is over 32).
