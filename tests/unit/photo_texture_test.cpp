@@ -1,6 +1,7 @@
 // The texture step on synthetic geometry with analytic photos: occlusion (a texel hidden from a photo does not take
 // its colour), the multi-band seam (no step where the photos agree, a gradual one where they do not), the fill.
 #include "fit/head/photo_texture.h"
+#include "common/error.h"
 #include "fit/head/surface_texels.h"
 #include "fit/head/view_depth.h"
 
@@ -627,6 +628,40 @@ TEST(PhotoTexture, PullPushFillsHolesFromTheirSurroundings) {
     EXPECT_NEAR(m[1], 100.0, 0.5);
     EXPECT_NEAR(m[2], 200.0, 0.5);
     EXPECT_EQ(cv::countNonZero(weight != 1.0f), 0);
+}
+
+// A cut-out texture: an opaque strand of one colour, a partly clear fringe darker than it, black where clear. After
+// the bleed the clear texels carry the strand's colour, the opaque ones keep theirs, and alpha is untouched.
+TEST(PhotoTexture, ClearTexelsOfACutOutTakeTheOpaqueTexelsColour) {
+    cv::Mat t(64, 64, CV_8UC4, cv::Scalar(0, 0, 0, 0));
+    t(cv::Rect(24, 0, 16, 64)).setTo(cv::Scalar(40, 80, 120, 255));
+    t(cv::Rect(22, 0, 2, 64)).setTo(cv::Scalar(10, 20, 30, 128));
+    t(cv::Rect(40, 0, 2, 64)).setTo(cv::Scalar(10, 20, 30, 128));
+    const cv::Mat before = t.clone();
+    bleedIntoClearTexels(t);
+    std::vector<cv::Mat> was, now;
+    cv::split(before, was);
+    cv::split(t, now);
+    EXPECT_EQ(cv::countNonZero(was[3] != now[3]), 0) << "alpha changed";
+    const cv::Scalar strand = cv::mean(t(cv::Rect(24, 0, 16, 64)));
+    EXPECT_EQ(strand, cv::Scalar(40, 80, 120, 255));
+    for (const int x : {0, 10, 21, 42, 50, 63}) {
+        const cv::Vec4b c = t.at<cv::Vec4b>(32, x);
+        EXPECT_NEAR(c[0], 40, 2) << x;
+        EXPECT_NEAR(c[1], 80, 2) << x;
+        EXPECT_NEAR(c[2], 120, 2) << x;
+    }
+    // The fringe, at alpha 128, keeps (128 - 112) / 112 of its own colour (opacity 224 and up keeps all of it, half
+    // of that and under none).
+    const double keep = (128.0 - 112.0) / 112.0;
+    for (const int x : {22, 41}) {
+        const cv::Vec4b c = t.at<cv::Vec4b>(32, x);
+        EXPECT_NEAR(c[0], keep * 10 + (1 - keep) * 40, 1.5) << x;
+        EXPECT_NEAR(c[1], keep * 20 + (1 - keep) * 80, 1.5) << x;
+        EXPECT_NEAR(c[2], keep * 30 + (1 - keep) * 120, 1.5) << x;
+    }
+    cv::Mat opaque(4, 4, CV_8UC3);
+    EXPECT_THROW(bleedIntoClearTexels(opaque), BoothError);
 }
 
 // The z-buffer: the nearer of two overlapping triangles wins, and pixels no triangle covers stay at -infinity.

@@ -16,6 +16,7 @@
 #include "fit/export/glb.h"
 #include "fit/face/profile.h"
 #include "fit/head/head_views.h"
+#include "fit/head/photo_texture.h"
 #include "fit/parts/head_proxy.h"
 
 #include <nlohmann/json.hpp>
@@ -751,8 +752,10 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
     if (!options.eyebrows.empty()) {
         HeadProxy brows = bindProxy("eyebrows", options.eyebrows, "eyebrows").first;
         brows.alpha = AlphaMode::Blend;
-        cv::extractChannel(brows.texture, brows.tintMask, 3);
-        cv::threshold(brows.tintMask, brows.tintMask, 8, 255, cv::THRESH_BINARY);
+        // Every texel takes the visitor's colour, the clear ones too (after the bleed, their colour is the hairs'
+        // beside them), so that no other colour is filtered into the edges.
+        bleedIntoClearTexels(brows.texture);
+        brows.tintMask = cv::Mat(brows.texture.size(), CV_8U, cv::Scalar(255));
         head.proxies.push_back(std::move(brows));
     }
     if (!options.eyelashes.empty()) {
@@ -766,8 +769,8 @@ MakeHumanHead importMakeHuman(const fs::path& packageDir, const MakeHumanImportO
         HeadProxy hair = bindProxy("hair", style, "hair").first;
         hair.alpha = AlphaMode::Mask;
         hair.alphaCutoff = 0.5;
-        cv::extractChannel(hair.texture, hair.tintMask, 3);
-        cv::threshold(hair.tintMask, hair.tintMask, 8, 255, cv::THRESH_BINARY);
+        bleedIntoClearTexels(hair.texture);
+        hair.tintMask = cv::Mat(hair.texture.size(), CV_8U, cv::Scalar(255));
         head.proxies.push_back(std::move(hair));
     }
     head.sideContour = findContourVertices(mesh, head.earHoleCentre, 1, defaultSideContourAngles());

@@ -78,6 +78,36 @@ void pullPushFill(cv::Mat& colour, cv::Mat& weight) {
     weight.setTo(1.0f);
 }
 
+void bleedIntoClearTexels(cv::Mat& bgra, int opaqueFrom) {
+    if (bgra.type() != CV_8UC4)
+        throw BoothError(ErrorKind::Internal, "", "bleedIntoClearTexels: needs a CV_8UC4 texture");
+    if (bgra.empty()) return;
+    cv::Mat bgr, alpha, own, fill, weight;
+    cv::cvtColor(bgra, bgr, cv::COLOR_BGRA2BGR);
+    cv::extractChannel(bgra, alpha, 3);
+    bgr.convertTo(own, CV_32FC3);
+    // The opaque texels alone are the fill's source: a partly clear one would lend its dark colour to all the clear
+    // texels round it (pullPushFill takes any content of a coarse level for known).
+    const int from = std::clamp(opaqueFrom, 1, 255);
+    cv::Mat opaque = alpha >= from;
+    opaque.convertTo(weight, CV_32F, 1.0 / 255.0);
+    fill = own.clone();
+    pullPushFill(fill, weight);
+    // Partly clear texels over half the opacity keep some of their own colour, in proportion.
+    const double half = from / 2.0;
+    for (int y = 0; y < bgra.rows; ++y) {
+        const auto* a = alpha.ptr<std::uint8_t>(y);
+        const auto* o = own.ptr<cv::Vec3f>(y);
+        const auto* f = fill.ptr<cv::Vec3f>(y);
+        auto* out = bgra.ptr<cv::Vec4b>(y);
+        for (int x = 0; x < bgra.cols; ++x) {
+            const auto keep = static_cast<float>(std::clamp((a[x] - half) / std::max(from - half, 1.0), 0.0, 1.0));
+            const cv::Vec3f c = keep * o[x] + (1.0f - keep) * f[x];
+            for (int k = 0; k < 3; ++k) out[x][k] = cv::saturate_cast<std::uint8_t>(c[k]);
+        }
+    }
+}
+
 namespace {
 
 // Rings of neighbours the normals that choose between the photos are averaged over (the face's grid spacing is

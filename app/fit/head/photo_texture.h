@@ -175,4 +175,10 @@ void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& detail);
 // with the fill. colour: CV_32FC3, weight: CV_32F (all 1 afterwards).
 void pullPushFill(cv::Mat& colour, cv::Mat& weight);
 
+// A cut-out texture's (CV_8UC4, BGRA) colour carried from its opaque texels (alpha at least `opaqueFrom`) into
+// its clear and partly clear ones by pullPushFill; alpha kept. MakeHuman's hair and brow textures are black where
+// clear and dark where partly clear, and a renderer's filtering mixes those texels' colour into the strands'
+// edges (long01's hairline was drawn with a dark fringe).
+void bleedIntoClearTexels(cv::Mat& bgra, int opaqueFrom = 224);
+
 }  // namespace avatarbooth
