@@ -309,13 +309,10 @@ FitOutcome FitPipeline::fit(const cv::Mat& front, const cv::Mat& side, const cv:
         if (out.hair.style == HairStyle::Bob) clear.above = foreheadShownMm(m.frontHair, out.frontLandmarks.points, out.fit.front);
         out.foreheadShownMm = clear.above;
         keepFaceClear(hair->mesh, base_, out.fit.mesh, clear);
-        if (out.hair.style == HairStyle::Short && settings_.trimShortHair &&
-            cv::norm(out.hair.hairLab - out.hair.skinLab) >= kTrimMinHairSkinContrast) {
-            HairPhotoMasks masks{m.frontHair, out.frontMask, m.sideHair, out.sideMask, out.fit.front, out.fit.side};
-            out.hairTrimmedVertices = trimShortHairToPhotos(hair->mesh, out.fit.mesh, masks);
-        }
         if (out.hair.style == HairStyle::Short) {
             HairPhotoMasks masks{m.frontHair, out.frontMask, m.sideHair, out.sideMask, out.fit.front, out.fit.side};
+            if (settings_.trimShortHair && cv::norm(out.hair.hairLab - out.hair.skinLab) >= kTrimMinHairSkinContrast)
+                out.hairTrimmedVertices = trimShortHairToPhotos(hair->mesh, out.fit.mesh, masks);
             out.hairPulledInVertices = pullShortHairIntoOutlines(hair->mesh, out.fit.mesh, masks);
         }
         // The fitted head's ears stand out further than those MakeHuman's styles were made over (under the hair as

@@ -110,19 +110,6 @@ double valueAt(const cv::Mat& image, const cv::Point2d& px, double beyond) {
     return static_cast<double>(image.at<float>(y, x));
 }
 
-// A CV_32F image's value at `px` interpolated bilinearly between pixel centres (clamped at the border), or
-// `beyond` outside the image.
-double bilinearAt(const cv::Mat& image, const cv::Point2d& px, double beyond) {
-    if (px.x < -0.5 || px.y < -0.5 || px.x > image.cols - 0.5 || px.y > image.rows - 0.5) return beyond;
-    const double x = std::clamp(px.x, 0.0, image.cols - 1.0), y = std::clamp(px.y, 0.0, image.rows - 1.0);
-    const int x0 = std::max(0, std::min(static_cast<int>(x), image.cols - 2));
-    const int y0 = std::max(0, std::min(static_cast<int>(y), image.rows - 2));
-    const int x1 = std::min(x0 + 1, image.cols - 1), y1 = std::min(y0 + 1, image.rows - 1);
-    const double fx = x - x0, fy = y - y0;
-    const auto at = [&](int yy, int xx) { return static_cast<double>(image.at<float>(yy, xx)); };
-    return (1 - fy) * ((1 - fx) * at(y0, x0) + fx * at(y0, x1)) + fy * ((1 - fx) * at(y1, x0) + fx * at(y1, x1));
-}
-
 }  // namespace
 
 int trimShortHairToPhotos(Mesh& hair, const Mesh& fittedHead, const HairPhotoMasks& photos, const HairTrim& trim) {
@@ -241,7 +228,12 @@ int pullShortHairIntoOutlines(Mesh& hair, const Mesh& fittedHead, const HairPhot
     // How far along the normal a point is past where the view's outline (plus the margin) lies: its distance out
     // of it over the part of n in the view's plane (to first order; a spot the view sees edge-on moves it the most).
     const auto past = [&](const cv::Mat& distance, const PhotoFrame& frame, const glm::dvec2& at, const glm::dvec2& nInView) {
-        const double d = bilinearAt(distance, frame.toPixel(at), std::numeric_limits<double>::infinity());
+        const cv::Point2d px = frame.toPixel(at);
+        if (px.x < -0.5 || px.y < -0.5 || px.x > distance.cols - 0.5 || px.y > distance.rows - 0.5)
+            return std::numeric_limits<double>::infinity();
+        cv::Mat sample;  // bilinear between pixel centres, the border replicated
+        cv::getRectSubPix(distance, cv::Size(1, 1), cv::Point2f(static_cast<float>(px.x), static_cast<float>(px.y)), sample);
+        const double d = sample.at<float>(0, 0);
         return (d - pull.margin) / std::max(glm::length(nInView), 0.3);
     };
     int moved = 0;
