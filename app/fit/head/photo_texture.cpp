@@ -20,6 +20,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 namespace avatarbooth {
 
@@ -136,6 +137,25 @@ struct Affine {
 struct TexelToPhoto {
     Affine fu, fv, su, sv;
 };
+
+// Triangle `t`'s corners in texel units (x right, y down), and whether it covers any area there.
+bool texelCorners(const Mesh& mesh, const glm::uvec3& t, cv::Size size, std::array<glm::dvec2, 3>& p) {
+    const std::uint32_t idx[3] = {t.x, t.y, t.z};
+    for (int k = 0; k < 3; ++k) p[k] = glm::dvec2(mesh.uvs[idx[k]].x * size.width, mesh.uvs[idx[k]].y * size.height);
+    const glm::dvec2 e1 = p[1] - p[0], e2 = p[2] - p[0];
+    return std::abs(e1.x * e2.y - e2.x * e1.y) >= 1e-12;  // degenerate in UV: no texel maps to it
+}
+
+// The quantity that is a0, a1, a2 at the corners p of a triangle (texel units), as an affine function of the texel
+// (x, y) whose centre is at (x + 0.5, y + 0.5). The triangle must not be degenerate (texelCorners).
+Affine affineOver(const std::array<glm::dvec2, 3>& p, double a0, double a1, double a2) {
+    const glm::dvec2 e1 = p[1] - p[0], e2 = p[2] - p[0];
+    const double det = e1.x * e2.y - e2.x * e1.y;
+    const double d1 = a1 - a0, d2 = a2 - a0;
+    const double gx = (d1 * e2.y - d2 * e1.y) / det, gy = (d2 * e1.x - d1 * e2.x) / det;
+    // Fold the texel centre's half and the first corner into the constant.
+    return Affine{static_cast<float>(a0 + gx * (0.5 - p[0].x) + gy * (0.5 - p[0].y)), static_cast<float>(gx), static_cast<float>(gy)};
+}
 
 // Vertex normals averaged over a few rings of neighbours. They decide which photo a texel takes: the fitted mesh has
 // creases (where the base head's parts meet, the nose's and lips' rims) whose normals turn sideways over a few
@@ -447,19 +467,9 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     std::vector<TexelToPhoto> toPhoto(fitted.triangles.size());
     for (std::size_t ti = 0; ti < fitted.triangles.size(); ++ti) {
         const glm::uvec3& t = fitted.triangles[ti];
-        const std::uint32_t idx[3] = {t.x, t.y, t.z};
-        glm::dvec2 p[3];
-        for (int k = 0; k < 3; ++k) p[k] = glm::dvec2(fitted.uvs[idx[k]].x * size.width, fitted.uvs[idx[k]].y * size.height);
-        const glm::dvec2 e1 = p[1] - p[0], e2 = p[2] - p[0];
-        const double det = e1.x * e2.y - e2.x * e1.y;
-        if (std::abs(det) < 1e-12) continue;  // degenerate in UV: no texel maps to it
-        const auto affine = [&](float VertexViews::*m) {
-            const double a0 = views[idx[0]].*m, d1 = views[idx[1]].*m - a0, d2 = views[idx[2]].*m - a0;
-            const double gx = (d1 * e2.y - d2 * e1.y) / det, gy = (d2 * e1.x - d1 * e2.x) / det;
-            // Texel (x, y) has its centre at (x + 0.5, y + 0.5): fold the half and the corner into the constant.
-            return Affine{static_cast<float>(a0 + gx * (0.5 - p[0].x) + gy * (0.5 - p[0].y)), static_cast<float>(gx),
-                          static_cast<float>(gy)};
-        };
+        std::array<glm::dvec2, 3> p;
+        if (!texelCorners(fitted, t, size, p)) continue;
+        const auto affine = [&](float VertexViews::*m) { return affineOver(p, views[t.x].*m, views[t.y].*m, views[t.z].*m); };
         toPhoto[ti] = {affine(&VertexViews::fu), affine(&VertexViews::fv), affine(&VertexViews::su), affine(&VertexViews::sv)};
     }
     std::array<cv::Mat, 3> depth;
@@ -479,7 +489,12 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     cv::Mat frontHalf(half, CV_32FC3, cv::Scalar::all(0)), sideHalf(half, CV_32FC3, cv::Scalar::all(0));
     cv::Mat frontSeen(half, CV_32F, cv::Scalar(0)), sideSeen(half, CV_32F, cv::Scalar(0));
     cv::Mat frontLabel(half, CV_8U, cv::Scalar(0));  // 255 where the blend takes the front photo's bands
-    cv::Mat matchMask(half, CV_32F, cv::Scalar(0));   // 1 on the texels the exposure match compares
+    // The exposure match's comparisons summed over cells of kShrink x kShrink texels (its local gain varies slowly):
+    // both photos' colours and the count per cell. Stripes of whole cell rows, so that no two threads share a cell.
+    constexpr int kShrink = 4;
+    const cv::Size coarse((half.width + kShrink - 1) / kShrink, (half.height + kShrink - 1) / kShrink);
+    cv::Mat frontNear(coarse, CV_32FC3, cv::Scalar::all(0)), sideNear(coarse, CV_32FC3, cv::Scalar::all(0));
+    cv::Mat weightNear(coarse, CV_32F, cv::Scalar(0));
     cv::Mat halfSource(half, CV_8U, cv::Scalar(PhotoTexture::Filled));  // the photo each texel takes
     constexpr int kStripes = 16;
     std::array<cv::Vec3d, kStripes> frontSum{}, sideSum{};
@@ -488,8 +503,12 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
         for (int stripe = stripes.start; stripe < stripes.end; ++stripe) {
             cv::Vec3d frontAcc(0, 0, 0), sideAcc(0, 0, 0);  // locals: neighbouring array entries share a cache line
             long overlapAcc = 0;
-            for (int y = half.height * stripe / kStripes; y < half.height * (stripe + 1) / kStripes; ++y) {
+            const auto stripeStart = [&](int k) { return std::min(half.height, coarse.height * k / kStripes * kShrink); };
+            for (int y = stripeStart(stripe); y < stripeStart(stripe + 1); ++y) {
                 const int* tri = halfMap.triangle.ptr<int>(y);
+                cv::Vec3f* frontCell = frontNear.ptr<cv::Vec3f>(y / kShrink);
+                cv::Vec3f* sideCell = sideNear.ptr<cv::Vec3f>(y / kShrink);
+                float* weightCell = weightNear.ptr<float>(y / kShrink);
                 cv::Vec3f* fc = frontHalf.ptr<cv::Vec3f>(y);
                 cv::Vec3f* sc = sideHalf.ptr<cv::Vec3f>(y);
                 float* fw = frontSeen.ptr<float>(y);
@@ -516,7 +535,9 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
                         frontAcc += cv::Vec3d(fc[x][0], fc[x][1], fc[x][2]);
                         sideAcc += cv::Vec3d(sc[x][0], sc[x][1], sc[x][2]);
                         ++overlapAcc;
-                        matchMask.at<float>(y, x) = 1.0f;
+                        frontCell[x / kShrink] += fc[x];
+                        sideCell[x / kShrink] += sc[x];
+                        weightCell[x / kShrink] += 1.0f;
                     }
                 }
             }
@@ -560,16 +581,14 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
     // eases into the one gain: continued there, the local gains made blocks of light and shade on 002's neck.
     cv::Mat gainMap(half, CV_32FC3, cv::Scalar(gain[0], gain[1], gain[2]));
     if (overlap >= kMinMatchTexels && options.exposureSmoothing > 0.0) {
-        // A gain varies slowly: it is measured on a copy of a quarter of the half-resolution texture's side (the
-        // Gaussians at half resolution cost 35 ms of processor time, at a quarter of it under 2) and read bilinearly.
-        constexpr int kShrink = 4;
-        const cv::Size coarse((half.width + kShrink - 1) / kShrink, (half.height + kShrink - 1) / kShrink);
+        // A gain varies slowly: it is measured on the cells' sums, a quarter of the half-resolution texture's side
+        // (the Gaussians at half resolution cost 35 ms of processor time, at a quarter of it under 2), and read
+        // bilinearly. Each cell's sums become its means over its 16 texels (an area average, compared or not).
         const double sigma = options.exposureSmoothing * coarse.width;
-        cv::Mat compared, frontNear, sideNear, weightNear;
-        cv::merge(std::vector<cv::Mat>{matchMask, matchMask, matchMask}, compared);
-        cv::resize(frontHalf.mul(compared), frontNear, coarse, 0, 0, cv::INTER_AREA);
-        cv::resize(sideHalf.mul(compared), sideNear, coarse, 0, 0, cv::INTER_AREA);
-        cv::resize(matchMask, weightNear, coarse, 0, 0, cv::INTER_AREA);
+        constexpr double kPerCell = 1.0 / (kShrink * kShrink);
+        frontNear *= kPerCell;
+        sideNear *= kPerCell;
+        weightNear *= kPerCell;
         cv::GaussianBlur(frontNear, frontNear, cv::Size(), sigma);
         cv::GaussianBlur(sideNear, sideNear, cv::Size(), sigma);
         cv::GaussianBlur(weightNear, weightNear, cv::Size(), sigma);
@@ -704,13 +723,17 @@ PhotoTexture textureFromPhotos(const Mesh& fitted, const HeadFit& fit, const cv:
 namespace {
 
 // A texel as a repaint sees it: the point of the head and, when it took a photo (`seen`), which and where in it
-// (pixel(), worked out only when asked: most texels of a repaint are decided by where they lie).
+// (`pixel`: interpolated over the triangle from its corners' pixels, as the texture read it).
 struct PhotoTexel {
     glm::dvec3 head;
     bool seen = false, front = false;
-    const HeadFit* fit = nullptr;
-    const PhotoTextureOptions* options = nullptr;
-    cv::Point2d pixel() const { return front ? fit->front.toPixel({head.x, head.y}) : sidePhotoPoint(*fit, *options, head); }
+    cv::Point2d pixel;
+};
+
+// Where a texel of a triangle lies on the head and in each photo, as affine functions of the texel's position.
+struct TexelToHead {
+    Affine x, y, z;
+    TexelToPhoto photo;
 };
 // What such a texel is to a repaint: a source of the skin's colour, or repainted by `repaint` (0..1), or neither.
 struct TexelRole {
@@ -771,6 +794,30 @@ int repaintWithSkin(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fi
     cv::Mat smallColour(small, CV_32FC3, cv::Scalar::all(0)), smallWeight(small, CV_32F, cv::Scalar(0));
     cv::Mat smallTarget(small, CV_32F, cv::Scalar(0)), smallTargetMax(small, CV_32F, cv::Scalar(0));
     cv::Mat target(size, CV_32F, cv::Scalar(0));
+    // Per triangle of the area, the head's point and both photos' pixels over its texels (per texel, the side photo's
+    // shifted reading and the barycentric sums cost more than all else the repaint does).
+    std::vector<TexelToHead> toHead(fitted.triangles.size());
+    {
+        std::vector<glm::dvec3> frontPx(fitted.positions.size()), sidePx(fitted.positions.size());
+        std::vector<unsigned char> done(fitted.positions.size(), 0);
+        for (std::size_t ti = 0; ti < fitted.triangles.size(); ++ti) {
+            if (!area.triangles[ti]) continue;
+            const glm::uvec3& t = fitted.triangles[ti];
+            std::array<glm::dvec2, 3> p;
+            if (!texelCorners(fitted, t, map.size, p)) continue;
+            for (const std::uint32_t k : {t.x, t.y, t.z}) {
+                if (done[k]) continue;
+                const glm::dvec3& v = fitted.positions[k];
+                const cv::Point2d f = fit.front.toPixel({v.x, v.y}), sd = sidePhotoPoint(fit, options, v);
+                frontPx[k] = {f.x, f.y, 0.0};
+                sidePx[k] = {sd.x, sd.y, 0.0};
+                done[k] = 1;
+            }
+            const auto over = [&](const std::vector<glm::dvec3>& a, int c) { return affineOver(p, a[t.x][c], a[t.y][c], a[t.z][c]); };
+            toHead[ti] = {over(fitted.positions, 0), over(fitted.positions, 1), over(fitted.positions, 2),
+                          {over(frontPx, 0), over(frontPx, 1), over(sidePx, 0), over(sidePx, 1)}};
+        }
+    }
     cv::parallel_for_(cv::Range(0, small.height), [&](const cv::Range& cells) {
         for (int y = cells.start * 4; y < std::min(size.height, cells.end * 4); ++y) {
             const int ty = box.y + y;
@@ -783,14 +830,14 @@ int repaintWithSkin(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fi
             float* cellTargetMax = smallTargetMax.ptr<float>(y / 4);
             for (int x = 0; x < size.width; ++x) {
                 if (tri[x] < 0 || !area.triangles[static_cast<std::size_t>(tri[x])]) continue;
-                const glm::uvec3& t = fitted.triangles[static_cast<std::size_t>(tri[x])];
-                const cv::Vec2d b = map.barycentric(tri[x], box.x + x, ty);
+                const TexelToHead& a = toHead[static_cast<std::size_t>(tri[x])];
+                const auto fx = static_cast<float>(box.x + x), fy = static_cast<float>(ty);
                 PhotoTexel texel;
-                texel.head = b[0] * fitted.positions[t.x] + b[1] * fitted.positions[t.y] + (1.0 - b[0] - b[1]) * fitted.positions[t.z];
+                texel.head = {a.x.at(fx, fy), a.y.at(fx, fy), a.z.at(fx, fy)};
                 texel.seen = src[x] == PhotoTexture::Front || src[x] == PhotoTexture::Side;
                 texel.front = src[x] == PhotoTexture::Front;
-                texel.fit = &fit;
-                texel.options = &options;
+                if (texel.front) texel.pixel = {a.photo.fu.at(fx, fy), a.photo.fv.at(fx, fy)};
+                else if (texel.seen) texel.pixel = {a.photo.su.at(fx, fy), a.photo.sv.at(fx, fy)};
                 const TexelRole r = role(texel, box.x + x, ty);
                 if (r.skin && texel.seen) {
                     cellColour[x / 4] += cv::Vec3f(in[x][0], in[x][1], in[x][2]);
@@ -887,8 +934,7 @@ int skinOverHairBesideFace(PhotoTexture& texture, const Mesh& fitted, const Head
     return repaintWithSkin(texture, fitted, fit, options, tables, area, [&](const PhotoTexel& t, int, int) {
         if (!t.seen) return TexelRole{};
         const cv::Mat& hair = t.front ? notSkin.frontNotSkin : notSkin.sideNotSkin;
-        const cv::Point2d px = t.pixel();
-        if (isSkin(hair, static_cast<float>(px.x), static_cast<float>(px.y))) return TexelRole{true, 0.0f};
+        if (isSkin(hair, static_cast<float>(t.pixel.x), static_cast<float>(t.pixel.y))) return TexelRole{true, 0.0f};
         return TexelRole{false, static_cast<float>(onSides(t.head))};
     });
 }
@@ -920,8 +966,7 @@ int skinOverClothesOnNeck(PhotoTexture& texture, const Mesh& fitted, const HeadF
         if (t.head.y > top + neck.fadeMm + kSkinAroundMm || (!under && !t.seen)) return TexelRole{};
         if (t.seen && (!under || neck.keepHairBehind || behind < 0.5)) {
             const cv::Mat& h = t.front ? hair.frontNotSkin : hair.sideNotSkin;
-            const cv::Point2d px = t.pixel();
-            if (!isSkin(h, static_cast<float>(px.x), static_cast<float>(px.y))) return TexelRole{};  // hair stays
+            if (!isSkin(h, static_cast<float>(t.pixel.x), static_cast<float>(t.pixel.y))) return TexelRole{};  // hair stays
         }
         if (skinDistance(x, y) <= neck.maxSkinDistance) return TexelRole{t.seen, 0.0f};
         return TexelRole{false, under ? static_cast<float>(fadeOutPast(t.head.y - top, neck.fadeMm)) : 0.0f};
@@ -933,22 +978,38 @@ void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& detail) {
     if (detail.type() != CV_8SC3) throw BoothError(ErrorKind::Internal, "", "texture: the skin detail must be CV_8SC3");
     // Feathered: the made-up texels take all of it, those a photo saw none, with a soft edge between (the mask
     // blurred at an eighth of the size: the edge needs no more).
-    cv::Mat filled, small, weight;
+    constexpr int kShrink = 8;
+    cv::Mat filled, small;
     cv::compare(texture.source, PhotoTexture::Filled, filled, cv::CMP_EQ);
-    cv::resize(filled, small, cv::Size(), 0.125, 0.125, cv::INTER_AREA);
+    cv::resize(filled, small, cv::Size(), 1.0 / kShrink, 1.0 / kShrink, cv::INTER_AREA);
     small.convertTo(small, CV_32F, 1.0 / 255.0);
     cv::GaussianBlur(small, small, cv::Size(), 1.5);
-    cv::resize(small, weight, texture.texture.size(), 0, 0, cv::INTER_LINEAR);
-    // One pass, touching only the texels the fill made up (most of the texture was seen and stays as it is).
-    for (int y = 0; y < weight.rows; ++y) {
-        const float* w = weight.ptr<float>(y);
-        const cv::Vec<schar, 3>* d = detail.ptr<cv::Vec<schar, 3>>(y);
-        cv::Vec3b* t = texture.texture.ptr<cv::Vec3b>(y);
-        for (int x = 0; x < weight.cols; ++x) {
-            if (w[x] <= 0.0f) continue;
-            for (int c = 0; c < 3; ++c) t[x][c] = cv::saturate_cast<unsigned char>(t[x][c] + w[x] * d[x][c]);
+    // The weight read bilinearly from the small mask (cells' centres at (i + 0.5) * kShrink), row by row on the
+    // threads, touching only the texels where it is above zero (most of the texture was seen and stays as it is).
+    const cv::Size size = texture.texture.size();
+    const auto tap = [](int full, int smallLength) {
+        const float h = (static_cast<float>(full) + 0.5f) / kShrink - 0.5f;
+        const int i0 = std::clamp(static_cast<int>(std::floor(h)), 0, smallLength - 1);
+        return std::tuple{i0, std::min(i0 + 1, smallLength - 1), std::clamp(h - static_cast<float>(i0), 0.0f, 1.0f)};
+    };
+    std::vector<std::tuple<int, int, float>> columns;
+    for (int x = 0; x < size.width; ++x) columns.push_back(tap(x, small.cols));
+    cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
+        for (int y = rows.start; y < rows.end; ++y) {
+            const auto [r0, r1, fy] = tap(y, small.rows);
+            const float* a = small.ptr<float>(r0);
+            const float* b = small.ptr<float>(r1);
+            const cv::Vec<schar, 3>* d = detail.ptr<cv::Vec<schar, 3>>(y);
+            cv::Vec3b* t = texture.texture.ptr<cv::Vec3b>(y);
+            for (int x = 0; x < size.width; ++x) {
+                const auto [c0, c1, fx] = columns[static_cast<std::size_t>(x)];
+                if (a[c0] <= 0.0f && a[c1] <= 0.0f && b[c0] <= 0.0f && b[c1] <= 0.0f) continue;
+                const float w = (1.0f - fy) * (a[c0] + fx * (a[c1] - a[c0])) + fy * (b[c0] + fx * (b[c1] - b[c0]));
+                if (w <= 0.0f) continue;
+                for (int c = 0; c < 3; ++c) t[x][c] = cv::saturate_cast<unsigned char>(t[x][c] + w * d[x][c]);
+            }
         }
-    }
+    });
 }
 
 }  // namespace avatarbooth
