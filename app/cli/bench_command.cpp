@@ -7,6 +7,7 @@
 #include "common/image_io.h"
 #include "common/recent_timings.h"
 #include "fit/fit_pipeline.h"
+#include "kiosk/kiosk.h"
 
 #include <chrono>
 #include <fstream>
@@ -39,13 +40,20 @@ void registerBenchCommand(CLI::App& app) {
     struct Options {
         FitPhotoFiles inputs;
         int runs = 5;
+        std::string heap = "fit";
     };
     auto o = std::make_shared<Options>();
     cmd->add_option("--front", o->inputs.front, "Front photo")->required();
     cmd->add_option("--side", o->inputs.side, "Side photo")->required();
     cmd->add_option("--background", o->inputs.background, "Empty-booth photo");
     cmd->add_option("-n,--runs", o->runs, "Runs (the first is a warm-up and not counted)")->capture_default_str()->check(CLI::Range(2, 1000));
+    cmd->add_option("--heap", o->heap,
+                    "Allocator settings: fit (as `fit` and `batch`: freed buffers kept for reuse) or kiosk (as `run`: "
+                    "large blocks handed back to the system, two arenas)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"fit", "kiosk"}));
     cmd->callback([o] {
+        if (o->heap == "kiosk") tuneAllocatorForKiosk();
         const auto base = productBaseHead();
         const FitPipeline pipeline{FitSettings{}, *base};
         const cv::Mat front = readPhoto(o->inputs.front), side = readPhoto(o->inputs.side);
@@ -74,6 +82,7 @@ void registerBenchCommand(CLI::App& app) {
         std::cout << "machine: " << cpuModel() << ", " << std::thread::hardware_concurrency() << " threads\n"
                   << "photos: front " << front.cols << "x" << front.rows << ", side " << side.cols << "x" << side.rows
                   << "; " << o->runs - 1 << " timed runs (after one warm-up)\n"
+                  << "heap: " << (o->heap == "kiosk" ? "as the kiosk's (128 kB mmap threshold, two arenas)" : "as `fit`'s (freed buffers up to 32 MB kept for reuse)") << "\n"
                   << "model loading (once, apart): " << static_cast<int>(pipeline.modelLoadSeconds() * 1000) << " ms\n"
                   << "load average when done: " << loadAverage()
                   << " (wall times grow with other work on the machine; processor time is the work itself, all threads)\n";

@@ -1,6 +1,7 @@
 // The avatarbooth executable: one binary, one subcommand per job (run, fit, batch, check, config, ...: cli/*.cpp).
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
+#include "common/heap_reuse.h"
 
 #include <spdlog/spdlog.h>
 
@@ -9,6 +10,7 @@
 #include <string>
 
 int main(int argc, char** argv) {
+    avatarbooth::keepFreedBuffersForReuse();
     CLI::App app{"avatarbooth: a photo booth that turns a front and a side photo into a 3-D head"};
     app.set_version_flag("--version", std::string("avatarbooth ") + AVATARBOOTH_VERSION);
     app.require_subcommand(1);

@@ -662,9 +662,11 @@ void tuneAllocatorForKiosk() {
     // Two malloc arenas shared by all threads instead of up to 8 per core (the fit, writer, preview and llvmpipe
     // threads each kept freed images in their own), and a fixed 128 KB mmap threshold, so that images and other
     // large blocks go back to the system when freed instead of staying in an arena whose threshold has risen to
-    // the largest block freed. The README ("Memory") has what each measured.
+    // the largest block freed. The README ("Memory") has what each measured. The trim threshold at glibc's default
+    // again: `main` raised it for the fits of `fit` and `batch` (common/heap_reuse.h).
     mallopt(M_ARENA_MAX, 2);
     mallopt(M_MMAP_THRESHOLD, 128 << 10);
+    mallopt(M_TRIM_THRESHOLD, 128 << 10);
 }
 
 KioskReport runKiosk(const BoothConfig& config, const KioskOptions& options) {
