@@ -84,6 +84,65 @@ SizedScore sizedScore(const SideCrop& c, const EarTemplate& ear, const cv::Point
     return out;
 }
 
+// The best place of one size whose window is not mostly hair and lies on the person: its score and the ear's middle
+// there (facing-right pixels), or nothing.
+std::optional<std::pair<float, cv::Point2d>> bestPlace(const SideCrop& c, const EarTemplate& ear, const cv::Point2d& expected,
+                                                        const EarLocatorOptions& o, const SizedScore& sized) {
+    if (sized.score.empty()) return std::nullopt;
+    const double f = sized.f;
+    const cv::Mat& tmask = sized.mask;
+    const auto middleAt = [&](const cv::Point& p) { return cv::Point2d(c.origin.x + p.x + ear.centre.x * f, c.origin.y + p.y + ear.centre.y * f); };
+    // The places within the search, best first.
+    std::vector<std::pair<float, cv::Point>> places;
+    for (int y = 0; y < sized.score.rows; ++y)
+        for (int x = 0; x < sized.score.cols; ++x) {
+            const cv::Point p = sized.first + cv::Point(x, y);
+            const cv::Point2d centre = middleAt(p);
+            const float v = sized.score.at<float>(y, x);
+            if (std::isfinite(v) && std::abs(centre.x - expected.x) <= o.searchAlong * c.V &&
+                std::abs(centre.y - expected.y) <= o.searchUpDown * c.V)
+                places.emplace_back(v, p);
+        }
+    std::sort(places.begin(), places.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    // How many of the window's pixels lie on hair and on the person: counted pixel by pixel for the first places
+    // (the best place is usually taken), then at every searched place at once (where hair covers the ear thousands
+    // of places are turned down, and counting each in turn took 450 ms: FRMDB 007).
+    std::vector<cv::Point> window;
+    cv::findNonZero(tmask, window);
+    const int windowSize = static_cast<int>(window.size());
+    const cv::Rect searched(sized.first, cv::Size(sized.score.cols + tmask.cols - 1, sized.score.rows + tmask.rows - 1));
+    cv::Mat hairCount, personCount;  // element (x, y): the window's top-left corner at sized.first + (x, y)
+    const auto countsUnder = [&](const cv::Mat& pixels) {
+        const cv::Mat onPixels = pixels(searched) != 0, inWindow = tmask != 0;
+        cv::Mat on, inside, counts;
+        onPixels.convertTo(on, CV_32F, 1.0 / 255.0);
+        inWindow.convertTo(inside, CV_32F, 1.0 / 255.0);
+        cv::matchTemplate(on, inside, counts, cv::TM_CCORR);
+        return counts;
+    };
+    constexpr std::size_t kCountedOneByOne = 16;
+    for (std::size_t k = 0; k < places.size(); ++k) {
+        const auto& [v, p] = places[k];
+        int onHair = 0, onPerson = 0;
+        if (k < kCountedOneByOne) {
+            for (const cv::Point& q : window) {
+                onHair += c.hair.at<unsigned char>(p + q) != 0;
+                onPerson += c.mask.at<unsigned char>(p + q) != 0;
+            }
+        } else {
+            if (hairCount.empty()) {
+                hairCount = countsUnder(c.hair);
+                personCount = countsUnder(c.mask);
+            }
+            onHair = cvRound(hairCount.at<float>(p - sized.first));
+            onPerson = cvRound(personCount.at<float>(p - sized.first));
+        }
+        if (2 * onHair > windowSize || onPerson < 0.95 * static_cast<double>(windowSize)) continue;
+        return std::make_pair(v, middleAt(p));
+    }
+    return std::nullopt;
+}
+
 // How well the photo's edges run along the template's (the helix's rim, the antihelix, the
 // concha's edge), at each of the sizes: the mean over the template's edges of cos 2(angle difference), weighted by
 // both strengths; random edges (hair, stubble) average out. Windows mostly on hair or off the person do not count.
@@ -98,69 +157,26 @@ std::optional<std::pair<cv::Point2d, double>> templatePeak(const SideCrop& c, co
     const double blur = std::max(0.5, 0.6 * pxPerMm);
     cv::GaussianBlur(grey, grey, {0, 0}, blur);
     const auto [pc, ps] = edgeDirections(grey, 0.05);
-    // The sizes' correlations are most of the locator's time: each on a thread of its own.
+    // Each size on a thread of its own: the correlations are most of the locator's time, and where hair covers the
+    // ear, turning its thousands of places down. Each size's best place that is not mostly hair and lies on the
+    // person; the best of those wins (the first size on a tie).
     std::vector<SizedScore> sizes(o.scales.size());
+    std::vector<std::optional<std::pair<float, cv::Point2d>>> taken(sizes.size());
     cv::parallel_for_(cv::Range(0, static_cast<int>(sizes.size())), [&](const cv::Range& r) {
-        for (int i = r.start; i < r.end; ++i)
-            sizes[static_cast<std::size_t>(i)] = sizedScore(c, ear, expected, o, pc, ps, o.scales[static_cast<std::size_t>(i)], pxPerMm, blur);
+        for (int i = r.start; i < r.end; ++i) {
+            const auto k = static_cast<std::size_t>(i);
+            sizes[k] = sizedScore(c, ear, expected, o, pc, ps, o.scales[k], pxPerMm, blur);
+            taken[k] = bestPlace(c, ear, expected, o, sizes[k]);
+        }
     });
     double best = -2.0;
     cv::Point2d at;
-    for (const SizedScore& sized : sizes) {
-        if (sized.score.empty()) continue;
-        const double f = sized.f;
-        const cv::Mat& tmask = sized.mask;
-        // The best places within the search first; the first whose window is not mostly hair and lies on the person.
-        std::vector<std::pair<float, cv::Point>> places;
-        for (int y = 0; y < sized.score.rows; ++y)
-            for (int x = 0; x < sized.score.cols; ++x) {
-                const cv::Point p = sized.first + cv::Point(x, y);
-                const cv::Point2d centre(c.origin.x + p.x + ear.centre.x * f, c.origin.y + p.y + ear.centre.y * f);
-                const float v = sized.score.at<float>(y, x);
-                if (v > best && std::isfinite(v) && std::abs(centre.x - expected.x) <= o.searchAlong * c.V &&
-                    std::abs(centre.y - expected.y) <= o.searchUpDown * c.V)
-                    places.emplace_back(v, p);
-            }
-        std::sort(places.begin(), places.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-        // How many of the window's pixels lie on hair and on the person: counted pixel by pixel for the first places
-        // (the best place is usually taken), then at every place at once (where hair covers the ear thousands of
-        // places are turned down, and counting each in turn took 450 ms: FRMDB 007).
-        std::vector<cv::Point> window;
-        cv::findNonZero(tmask, window);
-        const int windowSize = static_cast<int>(window.size());
-        cv::Mat hairCount, personCount;
-        const auto countsUnder = [&](const cv::Mat& pixels) {
-            const cv::Mat onPixels = pixels != 0, inWindow = tmask != 0;
-            cv::Mat on, inside, counts;
-            onPixels.convertTo(on, CV_32F, 1.0 / 255.0);
-            inWindow.convertTo(inside, CV_32F, 1.0 / 255.0);
-            cv::matchTemplate(on, inside, counts, cv::TM_CCORR);
-            return counts;
-        };
-        constexpr std::size_t kCountedOneByOne = 16;
-        for (std::size_t k = 0; k < places.size(); ++k) {
-            const auto& [v, p] = places[k];
-            int onHair = 0, onPerson = 0;
-            if (k < kCountedOneByOne) {
-                for (const cv::Point& q : window) {
-                    onHair += c.hair.at<unsigned char>(p + q) != 0;
-                    onPerson += c.mask.at<unsigned char>(p + q) != 0;
-                }
-            } else {
-                if (hairCount.empty()) {
-                    hairCount = countsUnder(c.hair);
-                    personCount = countsUnder(c.mask);
-                }
-                onHair = cvRound(hairCount.at<float>(p));
-                onPerson = cvRound(personCount.at<float>(p));
-            }
-            if (2 * onHair > windowSize || onPerson < 0.95 * static_cast<double>(windowSize)) continue;
-            best = v;
-            at = {c.origin.x + p.x + ear.centre.x * f, c.origin.y + p.y + ear.centre.y * f};
-            *scaleOut = sized.scale;
-            break;
+    for (std::size_t i = 0; i < sizes.size(); ++i)
+        if (taken[i] && taken[i]->first > best) {
+            best = taken[i]->first;
+            at = taken[i]->second;
+            *scaleOut = sizes[i].scale;
         }
-    }
     if (best < -1.0) return std::nullopt;
     return std::make_pair(at, best);
 }
