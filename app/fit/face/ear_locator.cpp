@@ -92,7 +92,7 @@ std::optional<std::pair<float, cv::Point2d>> bestPlace(const SideCrop& c, const 
     const double f = sized.f;
     const cv::Mat& tmask = sized.mask;
     const auto middleAt = [&](const cv::Point& p) { return cv::Point2d(c.origin.x + p.x + ear.centre.x * f, c.origin.y + p.y + ear.centre.y * f); };
-    // The places within the search, best first.
+    // The places within the search.
     std::vector<std::pair<float, cv::Point>> places;
     for (int y = 0; y < sized.score.rows; ++y)
         for (int x = 0; x < sized.score.cols; ++x) {
@@ -103,15 +103,19 @@ std::optional<std::pair<float, cv::Point2d>> bestPlace(const SideCrop& c, const 
                 std::abs(centre.y - expected.y) <= o.searchUpDown * c.V)
                 places.emplace_back(v, p);
         }
-    std::sort(places.begin(), places.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-    // How many of the window's pixels lie on hair and on the person: counted pixel by pixel for the first places
-    // (the best place is usually taken), then at every searched place at once (where hair covers the ear thousands
-    // of places are turned down, and counting each in turn took 450 ms: FRMDB 007).
+    // How many of the window's pixels lie on hair and on the person: counted pixel by pixel for the best places in
+    // turn (the best is usually taken), then at every searched place at once (where hair covers the ear thousands
+    // of places are turned down, and counting each in turn took 450 ms: FRMDB 007), taking the best of the rest
+    // that passes.
+    constexpr std::size_t kCountedOneByOne = 16;
+    const auto better = [](const auto& a, const auto& b) { return a.first > b.first; };
+    const auto counted = places.begin() + static_cast<std::ptrdiff_t>(std::min(kCountedOneByOne, places.size()));
+    std::partial_sort(places.begin(), counted, places.end(), better);
     std::vector<cv::Point> window;
     cv::findNonZero(tmask, window);
     const int windowSize = static_cast<int>(window.size());
     const cv::Rect searched(sized.first, cv::Size(sized.score.cols + tmask.cols - 1, sized.score.rows + tmask.rows - 1));
-    cv::Mat hairCount, personCount;  // element (x, y): the window's top-left corner at sized.first + (x, y)
+    // Element (x, y) of the counts: the window's top-left corner at sized.first + (x, y).
     const auto countsUnder = [&](const cv::Mat& pixels) {
         const cv::Mat onPixels = pixels(searched) != 0, inWindow = tmask != 0;
         cv::Mat on, inside, counts;
@@ -120,27 +124,26 @@ std::optional<std::pair<float, cv::Point2d>> bestPlace(const SideCrop& c, const 
         cv::matchTemplate(on, inside, counts, cv::TM_CCORR);
         return counts;
     };
-    constexpr std::size_t kCountedOneByOne = 16;
-    for (std::size_t k = 0; k < places.size(); ++k) {
-        const auto& [v, p] = places[k];
+    const auto passes = [&](int onHair, int onPerson) { return 2 * onHair <= windowSize && onPerson >= 0.95 * static_cast<double>(windowSize); };
+    for (auto it = places.begin(); it != counted; ++it) {
         int onHair = 0, onPerson = 0;
-        if (k < kCountedOneByOne) {
-            for (const cv::Point& q : window) {
-                onHair += c.hair.at<unsigned char>(p + q) != 0;
-                onPerson += c.mask.at<unsigned char>(p + q) != 0;
-            }
-        } else {
-            if (hairCount.empty()) {
-                hairCount = countsUnder(c.hair);
-                personCount = countsUnder(c.mask);
-            }
-            onHair = cvRound(hairCount.at<float>(p - sized.first));
-            onPerson = cvRound(personCount.at<float>(p - sized.first));
+        for (const cv::Point& q : window) {
+            onHair += c.hair.at<unsigned char>(it->second + q) != 0;
+            onPerson += c.mask.at<unsigned char>(it->second + q) != 0;
         }
-        if (2 * onHair > windowSize || onPerson < 0.95 * static_cast<double>(windowSize)) continue;
-        return std::make_pair(v, middleAt(p));
+        if (passes(onHair, onPerson)) return std::make_pair(it->first, middleAt(it->second));
     }
-    return std::nullopt;
+    if (counted == places.end()) return std::nullopt;
+    const cv::Mat hairCount = countsUnder(c.hair), personCount = countsUnder(c.mask);
+    auto taken = places.end();
+    for (auto it = counted; it != places.end(); ++it) {
+        const cv::Point at = it->second - sized.first;
+        if ((taken == places.end() || it->first > taken->first) &&
+            passes(cvRound(hairCount.at<float>(at)), cvRound(personCount.at<float>(at))))
+            taken = it;
+    }
+    if (taken == places.end()) return std::nullopt;
+    return std::make_pair(taken->first, middleAt(taken->second));
 }
 
 // How well the photo's edges run along the template's (the helix's rim, the antihelix, the
