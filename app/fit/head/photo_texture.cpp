@@ -20,7 +20,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <tuple>
 
 namespace avatarbooth {
 
@@ -196,40 +195,42 @@ inline cv::Vec3f bilinear(const cv::Mat& photo, float u, float v) {
     return out;
 }
 
+// Where full-resolution texel `full` reads an image `factor` times smaller (cells' centres at (i + 0.5) * factor):
+// the two cells along one axis and the second's weight.
+struct UpsampleTap {
+    int i0, i1;
+    float f;
+};
+UpsampleTap upsampleTap(int full, int smallLength, int factor) {
+    const float h = (static_cast<float>(full) + 0.5f) / static_cast<float>(factor) - 0.5f;
+    const int i0 = std::clamp(static_cast<int>(std::floor(h)), 0, smallLength - 1);
+    return {i0, std::min(i0 + 1, smallLength - 1), std::clamp(h - static_cast<float>(i0), 0.0f, 1.0f)};
+}
+
 // Bilinear upsampling by two of a CV_32FC3 image, one full-resolution row at a time (full-resolution texel centre
 // x + 0.5 is at half-resolution x / 2 - 0.25): the columns' taps are computed once.
 class HalfToFull {
 public:
     HalfToFull(cv::Size half, int fullWidth) : half_(half), taps_(static_cast<std::size_t>(fullWidth)) {
-        for (int x = 0; x < fullWidth; ++x) taps_[static_cast<std::size_t>(x)] = tap(x, half.width);
+        for (int x = 0; x < fullWidth; ++x) taps_[static_cast<std::size_t>(x)] = upsampleTap(x, half.width, 2);
     }
     // Row y of the upsampled image, as two half-resolution rows and the weight of the second.
     void row(const cv::Mat& image, int y, const cv::Vec3f*& r0, const cv::Vec3f*& r1, float& fy) const {
-        const Tap t = tap(y, half_.height);
+        const UpsampleTap t = upsampleTap(y, half_.height, 2);
         r0 = image.ptr<cv::Vec3f>(t.i0);
         r1 = image.ptr<cv::Vec3f>(t.i1);
         fy = t.f;
     }
     cv::Vec3f at(const cv::Vec3f* r0, const cv::Vec3f* r1, float fy, int x) const {
-        const Tap& t = taps_[static_cast<std::size_t>(x)];
+        const UpsampleTap& t = taps_[static_cast<std::size_t>(x)];
         const cv::Vec3f top = r0[t.i0] + (r0[t.i1] - r0[t.i0]) * t.f;
         const cv::Vec3f bottom = r1[t.i0] + (r1[t.i1] - r1[t.i0]) * t.f;
         return top + (bottom - top) * fy;
     }
 
 private:
-    struct Tap {
-        int i0, i1;
-        float f;
-    };
-    static Tap tap(int full, int halfLength) {
-        const float h = static_cast<float>(full) * 0.5f - 0.25f;
-        const int i0 = std::clamp(static_cast<int>(std::floor(h)), 0, halfLength - 1);
-        const int i1 = std::min(i0 + 1, halfLength - 1);
-        return {i0, i1, std::clamp(h - static_cast<float>(i0), 0.0f, 1.0f)};
-    }
     cv::Size half_;
-    std::vector<Tap> taps_;
+    std::vector<UpsampleTap> taps_;
 };
 
 // A silhouette shrunk by two pixels: photo pixels at the outline are part background, and a texel that samples
@@ -798,22 +799,18 @@ int repaintWithSkin(PhotoTexture& texture, const Mesh& fitted, const HeadFit& fi
     // shifted reading and the barycentric sums cost more than all else the repaint does).
     std::vector<TexelToHead> toHead(fitted.triangles.size());
     {
-        std::vector<glm::dvec3> frontPx(fitted.positions.size()), sidePx(fitted.positions.size());
-        std::vector<unsigned char> done(fitted.positions.size(), 0);
+        std::vector<glm::dvec2> frontPx, sidePx;
+        for (const glm::dvec3& v : fitted.positions) {
+            const cv::Point2d f = fit.front.toPixel({v.x, v.y}), sd = sidePhotoPoint(fit, options, v);
+            frontPx.emplace_back(f.x, f.y);
+            sidePx.emplace_back(sd.x, sd.y);
+        }
         for (std::size_t ti = 0; ti < fitted.triangles.size(); ++ti) {
             if (!area.triangles[ti]) continue;
             const glm::uvec3& t = fitted.triangles[ti];
             std::array<glm::dvec2, 3> p;
             if (!texelCorners(fitted, t, map.size, p)) continue;
-            for (const std::uint32_t k : {t.x, t.y, t.z}) {
-                if (done[k]) continue;
-                const glm::dvec3& v = fitted.positions[k];
-                const cv::Point2d f = fit.front.toPixel({v.x, v.y}), sd = sidePhotoPoint(fit, options, v);
-                frontPx[k] = {f.x, f.y, 0.0};
-                sidePx[k] = {sd.x, sd.y, 0.0};
-                done[k] = 1;
-            }
-            const auto over = [&](const std::vector<glm::dvec3>& a, int c) { return affineOver(p, a[t.x][c], a[t.y][c], a[t.z][c]); };
+            const auto over = [&](const auto& a, int c) { return affineOver(p, a[t.x][c], a[t.y][c], a[t.z][c]); };
             toHead[ti] = {over(fitted.positions, 0), over(fitted.positions, 1), over(fitted.positions, 2),
                           {over(frontPx, 0), over(frontPx, 1), over(sidePx, 0), over(sidePx, 1)}};
         }
@@ -987,26 +984,20 @@ void addBaseLayerDetail(PhotoTexture& texture, const cv::Mat& detail) {
     // The weight read bilinearly from the small mask (cells' centres at (i + 0.5) * kShrink), row by row on the
     // threads, touching only the texels where it is above zero (most of the texture was seen and stays as it is).
     const cv::Size size = texture.texture.size();
-    const auto tap = [](int full, int smallLength) {
-        const float h = (static_cast<float>(full) + 0.5f) / kShrink - 0.5f;
-        const int i0 = std::clamp(static_cast<int>(std::floor(h)), 0, smallLength - 1);
-        return std::tuple{i0, std::min(i0 + 1, smallLength - 1), std::clamp(h - static_cast<float>(i0), 0.0f, 1.0f)};
-    };
-    std::vector<std::tuple<int, int, float>> columns;
-    for (int x = 0; x < size.width; ++x) columns.push_back(tap(x, small.cols));
+    std::vector<UpsampleTap> columns;
+    for (int x = 0; x < size.width; ++x) columns.push_back(upsampleTap(x, small.cols, kShrink));
     cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
         for (int y = rows.start; y < rows.end; ++y) {
-            const auto [r0, r1, fy] = tap(y, small.rows);
-            const float* a = small.ptr<float>(r0);
-            const float* b = small.ptr<float>(r1);
+            const UpsampleTap row = upsampleTap(y, small.rows, kShrink);
+            const float* a = small.ptr<float>(row.i0);
+            const float* b = small.ptr<float>(row.i1);
             const cv::Vec<schar, 3>* d = detail.ptr<cv::Vec<schar, 3>>(y);
             cv::Vec3b* t = texture.texture.ptr<cv::Vec3b>(y);
             for (int x = 0; x < size.width; ++x) {
-                const auto [c0, c1, fx] = columns[static_cast<std::size_t>(x)];
-                if (a[c0] <= 0.0f && a[c1] <= 0.0f && b[c0] <= 0.0f && b[c1] <= 0.0f) continue;
-                const float w = (1.0f - fy) * (a[c0] + fx * (a[c1] - a[c0])) + fy * (b[c0] + fx * (b[c1] - b[c0]));
+                const UpsampleTap& c = columns[static_cast<std::size_t>(x)];
+                const float w = (1.0f - row.f) * (a[c.i0] + c.f * (a[c.i1] - a[c.i0])) + row.f * (b[c.i0] + c.f * (b[c.i1] - b[c.i0]));
                 if (w <= 0.0f) continue;
-                for (int c = 0; c < 3; ++c) t[x][c] = cv::saturate_cast<unsigned char>(t[x][c] + w * d[x][c]);
+                for (int k = 0; k < 3; ++k) t[x][k] = cv::saturate_cast<unsigned char>(t[x][k] + w * d[x][k]);
             }
         }
     });
